@@ -1,0 +1,258 @@
+// occull — command-line tool: device info, scenes, algorithms, benchmarks
+// and screenshots.
+//
+// Exit codes: 0 success; 1 unexpected internal error; 2 bad input (unknown
+// name, invalid number, bad option, corrupt file); 3 no usable OpenGL 4.5
+// (EGL or driver missing).
+#include "occull/culler.hpp"
+#include "occull/error.hpp"
+#include "occull/gl/context.hpp"
+#include "occull/harness.hpp"
+#include "occull/scenes.hpp"
+
+#include <CLI/CLI.hpp>
+#include <fmt/format.h>
+#include <stb_image_write.h>
+
+#include <chrono>
+#include <cstdio>
+#include <iostream>
+#include <unistd.h>
+
+namespace {
+
+constexpr int kExitInternal = 1;
+constexpr int kExitInput = 2;
+constexpr int kExitNoGl = 3;
+
+struct Size {
+  int width = 1280;
+  int height = 720;
+};
+
+Size parse_size(const std::string& text) {
+  int w = 0, h = 0;
+  char x = 0, extra = 0;
+  if (std::sscanf(text.c_str(), "%d%c%d%c", &w, &x, &h, &extra) != 3 || (x != 'x' && x != 'X'))
+    throw occull::InputError(fmt::format("--size '{}' is not WIDTHxHEIGHT (e.g. 1280x720)", text));
+  if (w < 1 || h < 1 || w > 16384 || h > 16384)
+    throw occull::InputError(fmt::format("--size {}x{}: each side must be in [1, 16384]", w, h));
+  return {w, h};
+}
+
+std::vector<std::string> split_list(const std::string& text) {
+  std::vector<std::string> out;
+  std::size_t pos = 0;
+  while (pos <= text.size()) {
+    const std::size_t comma = std::min(text.find(',', pos), text.size());
+    std::string item = text.substr(pos, comma - pos);
+    if (!item.empty()) out.push_back(item);
+    pos = comma + 1;
+  }
+  return out;
+}
+
+occull::gl::QueryMode parse_query_mode(const std::string& s) {
+  if (s == "samples") return occull::gl::QueryMode::samples_passed;
+  if (s == "any") return occull::gl::QueryMode::any_samples_passed;
+  if (s == "conservative") return occull::gl::QueryMode::any_samples_passed_conservative;
+  throw occull::InputError(
+      fmt::format("unknown query mode '{}'; valid modes: samples, any, conservative", s));
+}
+
+int cmd_info() {
+  const auto context = occull::gl::Context::create();
+  const auto d = context->info();
+  fmt::print("vendor          {}\nrenderer        {}\nversion         {}\nGLSL            {}\n"
+             "EGL platform    {}\n",
+             d.vendor, d.renderer, d.version, d.glsl_version, d.egl_platform);
+  fmt::print("query counter bits: GL_SAMPLES_PASSED {}, GL_ANY_SAMPLES_PASSED {}, GL_TIME_ELAPSED {}, "
+             "GL_TIMESTAMP {}\n",
+             d.samples_passed_bits, d.any_samples_passed_bits, d.time_elapsed_bits, d.timestamp_bits);
+  fmt::print("occlusion queries (GL_SAMPLES_PASSED, GL_ANY_SAMPLES_PASSED[_CONSERVATIVE]), "
+             "conditional rendering and timer queries are core in OpenGL 4.5.\n");
+  fmt::print("culling-relevant extensions ({}):\n", d.culling_extensions.size());
+  for (const auto& e : d.culling_extensions) fmt::print("  {}\n", e);
+  return 0;
+}
+
+int cmd_scenes() {
+  for (const auto& info : occull::embedded_scenes()) {
+    const auto bundle = occull::make_scene(info.name);
+    fmt::print("{} — {}\n", info.name, info.summary);
+    fmt::print("  default: {} objects ({} dynamic), {} triangles\n", bundle.scene.objects().size(),
+               bundle.scene.dynamic_objects().size(), bundle.scene.triangle_count());
+    fmt::print("  parameters ({}:key=value,...):\n", info.name);
+    for (const auto& p : info.params)
+      fmt::print("    {:<10} default {:<6} range [{}, {}]  {}\n", p.key, p.default_value, p.min,
+                 p.max, p.help);
+    fmt::print("  paths:\n");
+    for (const auto& path : bundle.paths)
+      fmt::print("    {:<10} {:.1f} s  {}\n", path.name(), path.duration(), path.description());
+    fmt::print("\n");
+  }
+  return 0;
+}
+
+int cmd_algos() {
+  for (const auto& a : occull::algorithms()) {
+    fmt::print("{:<10} {}{}\n", a.name, a.summary, a.conservative ? "" : " (may pop: not conservative)");
+    for (const auto& o : a.options)
+      fmt::print("    --opt {}.{}={}  {}\n", a.name, o.key, o.default_value, o.help);
+  }
+  return 0;
+}
+
+class Progress {
+ public:
+  Progress() : tty_(isatty(fileno(stderr)) != 0) {}
+  void operator()(std::string_view algo, int frame, int frames, bool warmup) {
+    const bool last = frame + 1 == frames;
+    if (!tty_ && !last) return;
+    std::fprintf(stderr, "%s[%.*s] %s %d/%d%s", tty_ ? "\r" : "", int(algo.size()), algo.data(),
+                 warmup ? "warm-up" : "frame", frame + 1, frames, tty_ ? "   " : "\n");
+    if (tty_ && last) std::fputc('\n', stderr);
+    std::fflush(stderr);
+  }
+
+ private:
+  bool tty_;
+};
+
+struct BenchArgs {
+  std::string scene = "city";
+  std::string path;
+  std::string algos;
+  int frames = 100;
+  int warmup = 8;
+  std::string size = "1280x720";
+  std::vector<std::string> opts;
+  std::string query_mode = "samples";
+};
+
+occull::Options parse_options(const std::vector<std::string>& opts) {
+  occull::Options options;
+  for (const auto& o : opts) options.set(o);
+  occull::check_options(options);
+  return options;
+}
+
+int cmd_bench(const BenchArgs& a) {
+  occull::BenchConfig c;
+  c.scene = a.scene;
+  c.path = a.path;
+  c.algorithms = split_list(a.algos);
+  c.frames = a.frames;
+  c.warmup = a.warmup;
+  const Size size = parse_size(a.size);
+  c.width = size.width;
+  c.height = size.height;
+  c.options = parse_options(a.opts);
+  c.query_mode = parse_query_mode(a.query_mode);
+  Progress progress;
+  const auto result = occull::run_bench(c, std::ref(progress));
+  occull::print_table(result, std::cout);
+  return 0;
+}
+
+struct RenderArgs {
+  std::string scene = "city";
+  std::string path;
+  std::string algo = "vfc";
+  int frame = 0;
+  int frames = 100;
+  std::string size = "1280x720";
+  std::string out = "occull.png";
+  std::vector<std::string> opts;
+};
+
+int cmd_render(const RenderArgs& a) {
+  const Size size = parse_size(a.size);
+  if (a.frames < 1) throw occull::InputError("--frames must be at least 1");
+  if (a.frame < 0 || a.frame >= a.frames)
+    throw occull::InputError(fmt::format("--frame {} is outside [0, {}] (--frames {})", a.frame,
+                                         a.frames - 1, a.frames));
+  const occull::Options options = parse_options(a.opts);
+  occull::gl::RendererOptions ropts;
+  ropts.width = size.width;
+  ropts.height = size.height;
+  occull::Session session(a.scene, ropts);
+  const auto& path = a.path.empty() ? session.bundle().paths.front() : session.bundle().path(a.path);
+  auto culler = occull::make_culler(a.algo, session.index(), options);
+  // Run the frames before K too, so cullers with temporal state see the
+  // same history they would in a benchmark.
+  occull::FrameStats stats;
+  for (int k = 0; k <= a.frame; ++k)
+    stats = session.run_frame(*culler, session.view_at(path, k, a.frames), path.frame_time(k, a.frames));
+  const auto pixels = session.renderer().read_rgba();
+  if (!stbi_write_png(a.out.c_str(), size.width, size.height, 4, pixels.data(), size.width * 4))
+    throw occull::InputError(fmt::format("cannot write '{}'", a.out));
+  fmt::print("wrote {} ({}x{}): {} / {} frame {} with {}: {} objects, {} triangles drawn\n", a.out,
+             size.width, size.height, a.scene, path.name(), a.frame, a.algo, stats.objects_rendered,
+             stats.triangles);
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"occull — occlusion culling with hardware occlusion queries, and the instrument "
+               "that measures it.\n\nExit codes: 0 success, 1 internal error, 2 bad input, "
+               "3 no usable OpenGL 4.5."};
+  app.require_subcommand(1);
+
+  app.add_subcommand("info", "GL vendor, renderer, version, query counter bits, culling extensions");
+  app.add_subcommand("scenes", "embedded scenes: parameters, camera paths, object and triangle counts");
+  app.add_subcommand("algos", "culling algorithms and their options (--opt algo.key=value)");
+
+  BenchArgs bench;
+  auto* b = app.add_subcommand("bench", "fly a camera path with each algorithm and report frame times");
+  b->add_option("--scene", bench.scene, "scene spec name[:key=value,...] (see occull scenes)")
+      ->capture_default_str();
+  b->add_option("--path", bench.path, "camera path (default: the scene's first)");
+  b->add_option("--algo", bench.algos, "comma-separated algorithms (default: all; see occull algos)");
+  b->add_option("--frames", bench.frames, "timed frames per algorithm")->capture_default_str();
+  b->add_option("--warmup", bench.warmup, "untimed warm-up frames per algorithm")->capture_default_str();
+  b->add_option("--size", bench.size, "render size WIDTHxHEIGHT")->capture_default_str();
+  b->add_option("--opt", bench.opts, "algorithm option algo.key=value (repeatable)");
+  b->add_option("--query-mode", bench.query_mode, "occlusion query target: samples, any, conservative")
+      ->capture_default_str();
+
+  RenderArgs render;
+  auto* r = app.add_subcommand("render", "render one frame of a path with an algorithm to a PNG");
+  r->add_option("--scene", render.scene, "scene spec name[:key=value,...]")->capture_default_str();
+  r->add_option("--path", render.path, "camera path (default: the scene's first)");
+  r->add_option("--algo", render.algo, "algorithm")->capture_default_str();
+  r->add_option("--frame", render.frame, "frame index K (0-based) of --frames along the path")
+      ->capture_default_str();
+  r->add_option("--frames", render.frames, "frames the path is divided into")->capture_default_str();
+  r->add_option("--size", render.size, "image size WIDTHxHEIGHT")->capture_default_str();
+  r->add_option("--out", render.out, "output PNG file")->capture_default_str();
+  r->add_option("--opt", render.opts, "algorithm option algo.key=value (repeatable)");
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int code = app.exit(e);
+    return code == 0 ? 0 : kExitInput;
+  }
+
+  try {
+    const std::string cmd = app.get_subcommands().front()->get_name();
+    if (cmd == "info") return cmd_info();
+    if (cmd == "scenes") return cmd_scenes();
+    if (cmd == "algos") return cmd_algos();
+    if (cmd == "bench") return cmd_bench(bench);
+    if (cmd == "render") return cmd_render(render);
+  } catch (const occull::InputError& e) {
+    std::cerr << "occull: " << e.what() << "\n";
+    return kExitInput;
+  } catch (const occull::GlUnavailable& e) {
+    std::cerr << "occull: no usable OpenGL: " << e.what() << "\n";
+    return kExitNoGl;
+  } catch (const std::exception& e) {
+    std::cerr << "occull: internal error: " << e.what() << "\n";
+    return kExitInternal;
+  }
+  return kExitInternal;
+}

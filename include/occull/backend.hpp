@@ -1,0 +1,75 @@
+// occull — the interface between a culler and a renderer.
+//
+// An engine integrates occull by implementing Backend over its own render
+// queue; occull ships an OpenGL 4.5 implementation (occull/gl/renderer.hpp).
+// Cullers never touch a graphics API: they only call these functions.
+#pragma once
+
+#include "occull/geometry.hpp"
+#include "occull/scene.hpp"
+
+#include <cstdint>
+#include <span>
+
+namespace occull {
+
+/// Handle of an occlusion query in flight. Valid from issue_query() until
+/// result() returns; the backend may reuse the number afterwards.
+using QueryId = std::uint32_t;
+
+/// Counters a backend keeps from its creation on (monotonic). Per-frame
+/// figures are differences of two snapshots (operator-).
+struct BackendStats {
+  std::uint64_t draw_calls = 0;        ///< object draws
+  std::uint64_t triangles = 0;         ///< triangles submitted in object draws
+  std::uint64_t objects_rendered = 0;  ///< objects drawn (== draw_calls for one draw per object)
+  std::uint64_t render_flushes = 0;    ///< calls of render() (render-queue flushes)
+  std::uint64_t queries = 0;           ///< occlusion queries issued
+  std::uint64_t query_boxes = 0;       ///< boxes drawn inside those queries
+  std::uint64_t state_changes = 0;     ///< switches between rendering and querying state
+  std::uint64_t material_changes = 0;  ///< material binds while rendering
+  double wait_ms = 0.0;                ///< wall time blocked inside result(), milliseconds
+  double backend_ms = 0.0;             ///< wall time inside any Backend call, milliseconds
+
+  friend BackendStats operator-(const BackendStats& a, const BackendStats& b) noexcept {
+    return {a.draw_calls - b.draw_calls,       a.triangles - b.triangles,
+            a.objects_rendered - b.objects_rendered, a.render_flushes - b.render_flushes,
+            a.queries - b.queries,             a.query_boxes - b.query_boxes,
+            a.state_changes - b.state_changes, a.material_changes - b.material_changes,
+            a.wait_ms - b.wait_ms,             a.backend_ms - b.backend_ms};
+  }
+};
+
+class Backend {
+ public:
+  virtual ~Backend() = default;
+
+  /// Render-queue flush: draws these objects with the current view. The
+  /// backend may reorder them (e.g. sort by material); opaque objects are in
+  /// the depth buffer before any later issue_query() is evaluated.
+  /// Translucent objects may be deferred to the end of the frame (they never
+  /// occlude). Precondition: every id is a valid object of the scene.
+  virtual void render(std::span<const ObjectId> objects) = 0;
+
+  /// Starts one occlusion query over the union of `boxes` (world space),
+  /// tested against the depth buffer as it stands after every earlier
+  /// render(); the boxes themselves write neither colour nor depth.
+  /// Preconditions: boxes non-empty, none empty. Never blocks.
+  virtual QueryId issue_query(std::span<const Aabb> boxes) = 0;
+
+  /// True when result(q) would not block. Never blocks. Precondition: q in flight.
+  virtual bool result_available(QueryId q) = 0;
+
+  /// Number of samples (pixels without multisampling) of the query's boxes
+  /// that passed the depth test. Blocks until known, then frees q.
+  /// Precondition: q in flight.
+  virtual std::uint64_t result(QueryId q) = 0;
+
+  /// Asks the device to start work submitted so far without waiting for it
+  /// (glFlush); helps queries finish while the culler does other work.
+  virtual void flush() {}
+
+  [[nodiscard]] virtual BackendStats stats() const = 0;
+};
+
+}  // namespace occull

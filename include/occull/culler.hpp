@@ -1,0 +1,90 @@
+// occull — the culler interface and the algorithm registry.
+#pragma once
+
+#include "occull/backend.hpp"
+#include "occull/bvh.hpp"
+#include "occull/scene.hpp"
+#include "occull/stats.hpp"
+#include "occull/view.hpp"
+
+#include <map>
+#include <memory>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace occull {
+
+/// What a culler reads: the scene and its hierarchy, shared read-only by
+/// every culler instance. Both must outlive the cullers made from them; the
+/// owner updates the scene and refits the BVH between frames.
+struct SceneIndex {
+  const Scene& scene;
+  const Bvh& bvh;
+};
+
+/// Algorithm options as "algorithm.key" -> "value" strings, e.g.
+/// "chcpp.batch" -> "50". Cullers read their own keys with typed getters;
+/// make_culler() rejects unknown keys of the algorithm it makes.
+class Options {
+ public:
+  Options() = default;
+  /// Adds "algo.key=value". Throws InputError when it is not of that form.
+  void set(std::string_view assignment);
+  void set(std::string key, std::string value) { values_[std::move(key)] = std::move(value); }
+  [[nodiscard]] bool has(const std::string& key) const { return values_.count(key) != 0; }
+  [[nodiscard]] const std::map<std::string, std::string>& values() const noexcept { return values_; }
+
+  /// Typed reads; `fallback` when absent. Throw InputError naming the key
+  /// when the value does not parse or lies outside [lo, hi].
+  [[nodiscard]] int get_int(const std::string& key, int fallback, int lo, int hi) const;
+  [[nodiscard]] double get_double(const std::string& key, double fallback, double lo,
+                                  double hi) const;
+  /// Accepts on/off, true/false, yes/no, 1/0.
+  [[nodiscard]] bool get_bool(const std::string& key, bool fallback) const;
+
+ private:
+  std::map<std::string, std::string> values_;
+};
+
+/// Culls and renders one view per call, keeping that view's visibility
+/// state between calls (one instance per view: split screen, shadow views).
+class Culler {
+ public:
+  virtual ~Culler() = default;
+  /// Renders the frame's visible objects through `backend`. The caller has
+  /// started the frame (cleared the targets) and closes it afterwards.
+  /// Returns the culler's own counters; timings and backend counters are
+  /// left for the caller to fill.
+  virtual FrameStats render_frame(const View& view, Backend& backend) = 0;
+};
+
+struct OptionInfo {
+  std::string key;            ///< without the algorithm prefix
+  std::string default_value;
+  std::string help;
+};
+
+struct AlgorithmInfo {
+  std::string name;
+  std::string summary;
+  bool conservative = true;   ///< never culls a visible object (verified by the harness)
+  std::vector<OptionInfo> options;
+};
+
+/// Every algorithm make_culler() knows, in presentation order.
+[[nodiscard]] std::span<const AlgorithmInfo> algorithms();
+/// Comma-separated list of algorithm names (for error messages and help).
+[[nodiscard]] std::string algorithm_names();
+
+/// Checks every key of `options`: its algorithm must exist and know the
+/// option. Throws InputError listing the valid algorithms or options.
+void check_options(const Options& options);
+
+/// Makes the named culler. Throws InputError for an unknown name (listing
+/// the valid ones) or an unknown / invalid option of that algorithm.
+[[nodiscard]] std::unique_ptr<Culler> make_culler(std::string_view name, const SceneIndex& index,
+                                                  const Options& options = {});
+
+}  // namespace occull

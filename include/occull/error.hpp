@@ -1,0 +1,25 @@
+// occull — error types shared by the library and the tools.
+#pragma once
+
+#include <stdexcept>
+#include <string>
+
+namespace occull {
+
+/// Bad input from a user: an unknown name, an invalid number, a corrupt file.
+/// The message says what is wrong and, for names, lists the valid ones.
+/// Tools map it to exit code 2.
+class InputError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+/// The platform cannot run the OpenGL reference renderer (no EGL display, no
+/// OpenGL 4.5 core context). The message names what is missing and which
+/// package or driver provides it. Tools map it to exit code 3.
+class GlUnavailable : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+}  // namespace occull

@@ -1,0 +1,94 @@
+// occull — the OpenGL 4.5 reference renderer: occull's Backend over real
+// GPU (or llvmpipe) draws and hardware occlusion queries.
+#pragma once
+
+#include "occull/backend.hpp"
+#include "occull/scene.hpp"
+#include "occull/view.hpp"
+
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+namespace occull::gl {
+
+/// Which occlusion query target the renderer uses (one pool per target).
+enum class QueryMode : std::uint8_t {
+  samples_passed,                   ///< GL_SAMPLES_PASSED: exact sample counts
+  any_samples_passed,               ///< GL_ANY_SAMPLES_PASSED: 0 or 1
+  any_samples_passed_conservative,  ///< GL_ANY_SAMPLES_PASSED_CONSERVATIVE: 0 or 1, may overestimate
+};
+
+struct RendererOptions {
+  int width = 1280;   ///< render-target size in pixels, 1..16384
+  int height = 720;
+  QueryMode query_mode = QueryMode::samples_passed;
+  bool write_ids = true;       ///< also write object ids (id + 1) into the R32UI target
+  bool cull_backfaces = true;  ///< for scene geometry (query boxes are never back-face culled)
+  glm::vec3 background{0.62f, 0.74f, 0.86f};
+};
+
+/// The reference renderer. Draws a Scene into an offscreen framebuffer with
+/// a colour (RGBA8), a depth (32-bit float) and an object-id (R32UI)
+/// attachment. Usage per frame: begin_frame(), any Backend calls (usually a
+/// Culler::render_frame), end_frame().
+///
+/// Rendering: one draw per object from static vertex/index buffers, object
+/// transforms in a storage buffer (dynamic objects re-uploaded by
+/// begin_frame), each render() call sorted by material (stable, so a
+/// front-to-back order within a material survives). Translucent objects are
+/// deferred to end_frame() and drawn back to front with blending, without
+/// writing depth or ids: they never occlude.
+///
+/// Queries: one shared unit cube drawn instanced, one instance per box, with
+/// colour and depth writes off, depth test LEQUAL, polygon offset towards the
+/// eye, depth clamping (a box crossing the near plane is not clipped away)
+/// and no face culling, so that a query never reports fewer samples than
+/// the box's visible surface has. Samples therefore count front and back
+/// faces where both pass.
+///
+/// Preconditions: a gl::Context is current on the calling thread for the
+/// renderer's whole life; `scene` outlives the renderer and keeps its
+/// objects (update() may move dynamic ones).
+class Renderer final : public Backend {
+ public:
+  Renderer(const Scene& scene, const RendererOptions& options);
+  ~Renderer() override;
+  Renderer(const Renderer&) = delete;
+  Renderer& operator=(const Renderer&) = delete;
+
+  /// Clears the targets, sets the camera and uploads dynamic transforms.
+  void begin_frame(const View& view);
+  /// Draws the deferred translucent objects, then waits for the GPU
+  /// (glFinish). Returns the GPU time of the frame in milliseconds from a
+  /// timer query (0 when the device has no timer).
+  double end_frame();
+
+  // Backend
+  void render(std::span<const ObjectId> objects) override;
+  QueryId issue_query(std::span<const Aabb> boxes) override;
+  bool result_available(QueryId q) override;
+  std::uint64_t result(QueryId q) override;
+  void flush() override;
+  [[nodiscard]] BackendStats stats() const override { return stats_; }
+
+  /// Writing object ids can be switched off (timed runs that do not verify).
+  void set_write_ids(bool on);
+  /// The object-id target after end_frame(): width*height values, bottom
+  /// row first; 0 is background, otherwise object id + 1.
+  [[nodiscard]] std::vector<std::uint32_t> read_ids() const;
+  /// The colour target after end_frame(): width*height RGBA8 pixels, top row first.
+  [[nodiscard]] std::vector<std::uint8_t> read_rgba() const;
+  /// Queries in flight (issued and not yet read by result()).
+  [[nodiscard]] std::size_t queries_in_flight() const noexcept;
+
+  [[nodiscard]] int width() const noexcept;
+  [[nodiscard]] int height() const noexcept;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+  BackendStats stats_;
+};
+
+}  // namespace occull::gl

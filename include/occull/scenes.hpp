@@ -1,0 +1,52 @@
+// occull — embedded procedural scenes and their camera paths.
+//
+// Every scene is generated in-process from its parameters (including a
+// seed): the same spec gives the same scene, byte for byte.
+#pragma once
+
+#include "occull/scene.hpp"
+#include "occull/view.hpp"
+
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace occull {
+
+struct SceneParamInfo {
+  std::string key;
+  double default_value = 0.0;
+  double min = 0.0;
+  double max = 0.0;
+  bool integer = true;
+  std::string help;
+};
+
+struct SceneInfo {
+  std::string name;
+  std::string summary;
+  std::vector<SceneParamInfo> params;
+  std::vector<std::string> paths;  ///< camera path names, default first
+};
+
+/// A generated scene with its camera paths and lens.
+struct SceneBundle {
+  Scene scene;
+  std::vector<CameraPath> paths;  ///< default first
+  Lens lens;
+
+  /// The named path. Throws InputError listing the valid names.
+  [[nodiscard]] const CameraPath& path(std::string_view name) const;
+};
+
+/// The embedded scenes, in presentation order.
+[[nodiscard]] std::span<const SceneInfo> embedded_scenes();
+
+/// Builds a scene from a spec "name[:key=value[,key=value...]]", e.g.
+/// "city:blocks=6,seed=3". Throws InputError for an unknown scene (listing
+/// the valid ones), an unknown parameter (listing that scene's) or a value
+/// out of range.
+[[nodiscard]] SceneBundle make_scene(std::string_view spec);
+
+}  // namespace occull

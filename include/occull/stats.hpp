@@ -1,0 +1,35 @@
+// occull — per-frame statistics.
+#pragma once
+
+#include <cstdint>
+
+namespace occull {
+
+/// What one frame of one culler cost. A culler fills the counters it owns
+/// (nodes_visited, multiqueries, ...); the harness adds the backend's
+/// counters and the timings. Times in milliseconds.
+struct FrameStats {
+  // Timings.
+  double frame_ms = 0.0;  ///< wall time of the whole frame, closed by glFinish
+  double cpu_ms = 0.0;    ///< culler's own CPU time (frame time inside render_frame minus backend calls)
+  double wait_ms = 0.0;   ///< time blocked on query results
+  double gpu_ms = 0.0;    ///< GPU time from timer queries (0 when unavailable)
+
+  // Culler counters.
+  std::uint64_t nodes_visited = 0;        ///< hierarchy nodes the traversal touched
+  std::uint64_t multiqueries = 0;         ///< queries covering more than one node
+  std::uint64_t failed_multiqueries = 0;  ///< multiqueries that came back visible
+  std::uint64_t query_batches = 0;        ///< batches of queries issued together
+
+  // Backend counters (differences over the frame).
+  std::uint64_t queries = 0;
+  std::uint64_t query_boxes = 0;
+  std::uint64_t state_changes = 0;
+  std::uint64_t material_changes = 0;
+  std::uint64_t render_flushes = 0;
+  std::uint64_t draw_calls = 0;
+  std::uint64_t triangles = 0;
+  std::uint64_t objects_rendered = 0;
+};
+
+}  // namespace occull

@@ -1,0 +1,75 @@
+// occull — views and camera paths.
+#pragma once
+
+#include "occull/geometry.hpp"
+
+#include <string>
+#include <vector>
+
+namespace occull {
+
+/// One camera's view for one frame. Build it with make_view() so the derived
+/// members (view_proj, frustum) agree with the others.
+struct View {
+  glm::vec3 eye{0.0f};       ///< camera position, world space
+  glm::mat4 view{1.0f};      ///< world to eye space
+  glm::mat4 proj{1.0f};      ///< eye to clip space (OpenGL conventions)
+  glm::mat4 view_proj{1.0f}; ///< proj * view
+  Frustum frustum;           ///< planes of view_proj
+  int width = 1;             ///< viewport width, pixels (> 0)
+  int height = 1;            ///< viewport height, pixels (> 0)
+  float near = 0.1f;         ///< near-plane distance, scene units (> 0)
+  float far = 1000.0f;       ///< far-plane distance, scene units (> near)
+};
+
+/// Lens of a perspective camera.
+struct Lens {
+  float fov_y_degrees = 60.0f;  ///< vertical field of view, in (0, 180)
+  float near = 0.1f;            ///< scene units, > 0
+  float far = 2000.0f;          ///< scene units, > near
+};
+
+/// A camera pose. Yaw turns about +Y (0 looks down -Z, positive turns left
+/// towards -X); pitch looks up when positive. Both in radians.
+struct CameraPose {
+  glm::vec3 position{0.0f};
+  float yaw = 0.0f;
+  float pitch = 0.0f;
+};
+
+/// The view of `pose` through `lens` on a width x height viewport.
+/// Preconditions: width > 0, height > 0, |pitch| < pi/2.
+[[nodiscard]] View make_view(const CameraPose& pose, const Lens& lens, int width, int height);
+
+/// A keyframed camera path. Poses are interpolated linearly between keys
+/// (yaw along the shorter arc); a key marked `cut` is jumped to without
+/// interpolation (a sudden change of viewpoint).
+class CameraPath {
+ public:
+  struct Key {
+    double time = 0.0;  ///< seconds, strictly increasing along the path
+    CameraPose pose;
+    bool cut = false;   ///< arrive here by a jump rather than by moving
+  };
+
+  CameraPath() = default;
+  /// Preconditions: keys non-empty, times strictly increasing.
+  CameraPath(std::string name, std::string description, std::vector<Key> keys);
+
+  [[nodiscard]] const std::string& name() const noexcept { return name_; }
+  [[nodiscard]] const std::string& description() const noexcept { return description_; }
+  [[nodiscard]] const std::vector<Key>& keys() const noexcept { return keys_; }
+  /// Seconds from the first key to the last.
+  [[nodiscard]] double duration() const noexcept;
+  /// Pose at `time_s` (clamped to the path's time range).
+  [[nodiscard]] CameraPose sample(double time_s) const;
+  /// Time of frame `k` of `frames` spread evenly over the path (frames >= 1).
+  [[nodiscard]] double frame_time(int k, int frames) const noexcept;
+
+ private:
+  std::string name_;
+  std::string description_;
+  std::vector<Key> keys_;
+};
+
+}  // namespace occull

@@ -1,0 +1,171 @@
+#include "occull/geometry.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+namespace occull {
+
+float Aabb::surface_area() const noexcept {
+  if (empty()) return 0.0f;
+  const glm::vec3 e = extent();
+  return 2.0f * (e.x * e.y + e.y * e.z + e.z * e.x);
+}
+
+float Aabb::volume() const noexcept {
+  if (empty()) return 0.0f;
+  const glm::vec3 e = extent();
+  return e.x * e.y * e.z;
+}
+
+Aabb transform_box(const Aabb& b, const glm::mat4& m) noexcept {
+  // Arvo's method: each output axis is the sum of the extremes of the
+  // products of one matrix row with the box interval.
+  Aabb out;
+  const glm::vec3 t(m[3]);
+  out.min = t;
+  out.max = t;
+  for (int col = 0; col < 3; ++col) {
+    for (int row = 0; row < 3; ++row) {
+      const float a = m[col][row] * b.min[col];
+      const float c = m[col][row] * b.max[col];
+      out.min[row] += std::min(a, c);
+      out.max[row] += std::max(a, c);
+    }
+  }
+  return out;
+}
+
+float distance(const glm::vec3& p, const Aabb& b) noexcept {
+  const glm::vec3 q = glm::clamp(p, b.min, b.max);
+  return glm::length(p - q);
+}
+
+Plane Plane::from_coefficients(const glm::vec4& abcd) noexcept {
+  const glm::vec3 n(abcd);
+  const float len = glm::length(n);
+  return Plane{n / len, abcd.w / len};
+}
+
+Frustum Frustum::from_view_projection(const glm::mat4& m) noexcept {
+  const auto row = [&m](int i) { return glm::vec4(m[0][i], m[1][i], m[2][i], m[3][i]); };
+  Frustum f;
+  f.planes_[left] = Plane::from_coefficients(row(3) + row(0));
+  f.planes_[right] = Plane::from_coefficients(row(3) - row(0));
+  f.planes_[bottom] = Plane::from_coefficients(row(3) + row(1));
+  f.planes_[top] = Plane::from_coefficients(row(3) - row(1));
+  f.planes_[near] = Plane::from_coefficients(row(3) + row(2));
+  f.planes_[far] = Plane::from_coefficients(row(3) - row(2));
+  return f;
+}
+
+Containment Frustum::classify(const Aabb& box, std::uint32_t& plane_mask) const noexcept {
+  for (int i = 0; i < count; ++i) {
+    const std::uint32_t bit = 1u << i;
+    if (!(plane_mask & bit)) continue;
+    const Plane& p = planes_[i];
+    // The corner farthest along the normal decides "outside"; the nearest
+    // one decides "fully inside this plane".
+    const glm::vec3 far_corner(p.n.x >= 0 ? box.max.x : box.min.x,
+                               p.n.y >= 0 ? box.max.y : box.min.y,
+                               p.n.z >= 0 ? box.max.z : box.min.z);
+    if (p.signed_distance(far_corner) < 0.0f) return Containment::outside;
+    const glm::vec3 near_corner(p.n.x >= 0 ? box.min.x : box.max.x,
+                                p.n.y >= 0 ? box.min.y : box.max.y,
+                                p.n.z >= 0 ? box.min.z : box.max.z);
+    if (p.signed_distance(near_corner) >= 0.0f) plane_mask &= ~bit;
+  }
+  return plane_mask == 0 ? Containment::inside : Containment::intersecting;
+}
+
+double polygon_area(std::span<const glm::dvec2> pts) noexcept {
+  double twice = 0.0;
+  for (std::size_t i = 0, n = pts.size(); i < n; ++i) {
+    const glm::dvec2& a = pts[i];
+    const glm::dvec2& b = pts[(i + 1) % n];
+    twice += a.x * b.y - b.x * a.y;
+  }
+  return std::abs(twice) * 0.5;
+}
+
+namespace {
+
+double cross(const glm::dvec2& o, const glm::dvec2& a, const glm::dvec2& b) {
+  return (a.x - o.x) * (b.y - o.y) - (a.y - o.y) * (b.x - o.x);
+}
+
+// Andrew's monotone chain; returns the hull counter-clockwise.
+std::vector<glm::dvec2> convex_hull(std::vector<glm::dvec2> pts) {
+  std::sort(pts.begin(), pts.end(),
+            [](const glm::dvec2& a, const glm::dvec2& b) { return a.x < b.x || (a.x == b.x && a.y < b.y); });
+  if (pts.size() < 3) return pts;
+  std::vector<glm::dvec2> hull(2 * pts.size());
+  std::size_t k = 0;
+  for (const auto& p : pts) {
+    while (k >= 2 && cross(hull[k - 2], hull[k - 1], p) <= 0) --k;
+    hull[k++] = p;
+  }
+  for (std::size_t i = pts.size() - 1, lower = k + 1; i-- > 0;) {
+    while (k >= lower && cross(hull[k - 2], hull[k - 1], pts[i]) <= 0) --k;
+    hull[k++] = pts[i];
+  }
+  hull.resize(k - 1);
+  return hull;
+}
+
+// Sutherland–Hodgman against one axis-aligned half-plane: keeps points whose
+// coordinate `axis` is >= bound (sign = +1) or <= bound (sign = -1).
+std::vector<glm::dvec2> clip_half_plane(const std::vector<glm::dvec2>& poly, int axis,
+                                        double bound, double sign) {
+  std::vector<glm::dvec2> out;
+  const std::size_t n = poly.size();
+  for (std::size_t i = 0; i < n; ++i) {
+    const glm::dvec2& a = poly[i];
+    const glm::dvec2& b = poly[(i + 1) % n];
+    const double da = sign * (a[axis] - bound);
+    const double db = sign * (b[axis] - bound);
+    if (da >= 0) out.push_back(a);
+    if ((da >= 0) != (db >= 0)) out.push_back(a + (b - a) * (da / (da - db)));
+  }
+  return out;
+}
+
+}  // namespace
+
+double projected_area(const Aabb& b, const glm::mat4& view_proj, int width, int height) noexcept {
+  if (b.empty() || width <= 0 || height <= 0) return 0.0;
+  static constexpr int edges[12][2] = {{0, 1}, {2, 3}, {4, 5}, {6, 7}, {0, 2}, {1, 3},
+                                       {4, 6}, {5, 7}, {0, 4}, {1, 5}, {2, 6}, {3, 7}};
+  std::array<glm::dvec4, 8> clip;
+  for (int i = 0; i < 8; ++i) clip[i] = glm::dvec4(view_proj * glm::vec4(b.corner(i), 1.0f));
+  // Distance to the near plane in clip space is z + w (OpenGL conventions).
+  const auto near_dist = [](const glm::dvec4& c) { return c.z + c.w; };
+
+  std::vector<glm::dvec2> pts;
+  pts.reserve(20);
+  const auto add = [&](const glm::dvec4& c) {
+    const glm::dvec2 ndc(c.x / c.w, c.y / c.w);
+    pts.emplace_back((ndc.x * 0.5 + 0.5) * width, (ndc.y * 0.5 + 0.5) * height);
+  };
+  for (const auto& c : clip)
+    if (near_dist(c) >= 0 && c.w > 0) add(c);
+  for (const auto& e : edges) {
+    const glm::dvec4& a = clip[e[0]];
+    const glm::dvec4& c = clip[e[1]];
+    const double da = near_dist(a), dc = near_dist(c);
+    if ((da >= 0) != (dc >= 0)) {
+      const glm::dvec4 p = a + (c - a) * (da / (da - dc));
+      if (p.w > 0) add(p);
+    }
+  }
+  if (pts.size() < 3) return 0.0;
+  std::vector<glm::dvec2> poly = convex_hull(std::move(pts));
+  poly = clip_half_plane(poly, 0, 0.0, 1.0);
+  poly = clip_half_plane(poly, 0, double(width), -1.0);
+  poly = clip_half_plane(poly, 1, 0.0, 1.0);
+  poly = clip_half_plane(poly, 1, double(height), -1.0);
+  if (poly.size() < 3) return 0.0;
+  return polygon_area(poly);
+}
+
+}  // namespace occull

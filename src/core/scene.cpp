@@ -1,0 +1,107 @@
+#include "occull/scene.hpp"
+
+#include <glm/gtc/matrix_transform.hpp>
+
+#include <cassert>
+#include <cmath>
+
+namespace occull {
+
+Aabb Mesh::bounds() const noexcept {
+  Aabb b;
+  for (const auto& p : positions) b.extend(p);
+  return b;
+}
+
+double Mesh::surface_area() const noexcept {
+  double area = 0.0;
+  for (std::size_t i = 0; i + 2 < indices.size(); i += 3) {
+    const glm::dvec3 a(positions[indices[i]]);
+    const glm::dvec3 b(positions[indices[i + 1]]);
+    const glm::dvec3 c(positions[indices[i + 2]]);
+    area += 0.5 * glm::length(glm::cross(b - a, c - a));
+  }
+  return area;
+}
+
+glm::mat4 Motion::transform_at(double time_s) const {
+  assert(waypoints.size() >= 2 && speed > 0.0f);
+  const std::size_t n = waypoints.size();
+  double loop = 0.0;
+  for (std::size_t i = 0; i < n; ++i) loop += glm::length(waypoints[(i + 1) % n] - waypoints[i]);
+  double s = std::fmod(start_offset + speed * time_s, loop);
+  if (s < 0.0) s += loop;
+  for (std::size_t i = 0; i < n; ++i) {
+    const glm::vec3 a = waypoints[i];
+    const glm::vec3 b = waypoints[(i + 1) % n];
+    const double len = glm::length(b - a);
+    if (s <= len || i + 1 == n) {
+      const float f = len > 0.0 ? float(std::min(s / len, 1.0)) : 0.0f;
+      const glm::vec3 p = a + (b - a) * f;
+      const glm::vec3 dir = b - a;
+      const float yaw = std::atan2(-dir.z, dir.x);  // +X turned about +Y
+      return glm::rotate(glm::translate(glm::mat4(1.0f), p), yaw, glm::vec3(0, 1, 0));
+    }
+    s -= len;
+  }
+  return glm::translate(glm::mat4(1.0f), waypoints.front());
+}
+
+MeshId Scene::add_mesh(Mesh mesh) {
+  assert(mesh.normals.size() == mesh.positions.size());
+  mesh_bounds_.push_back(mesh.bounds());
+  meshes_.push_back(std::move(mesh));
+  return MeshId(meshes_.size() - 1);
+}
+
+MaterialId Scene::add_material(Material material) {
+  materials_.push_back(std::move(material));
+  return MaterialId(materials_.size() - 1);
+}
+
+ObjectId Scene::add_object(MeshId mesh, MaterialId material, const glm::mat4& transform,
+                           OccluderClass occluder) {
+  assert(mesh < meshes_.size() && material < materials_.size());
+  Object o;
+  o.mesh = mesh;
+  o.material = material;
+  o.transform = transform;
+  o.bounds = transform_box(mesh_bounds_[mesh], transform);
+  o.triangles = std::uint32_t(meshes_[mesh].triangle_count());
+  o.occluder = occluder;
+  objects_.push_back(o);
+  return ObjectId(objects_.size() - 1);
+}
+
+ObjectId Scene::add_dynamic_object(MeshId mesh, MaterialId material, Motion motion,
+                                   OccluderClass occluder, const glm::mat4& local) {
+  const glm::mat4 start = motion.transform_at(0.0) * local;
+  const ObjectId id = add_object(mesh, material, start, occluder);
+  motions_.push_back(std::move(motion));
+  dynamic_local_.push_back(local);
+  objects_[id].motion = std::int32_t(motions_.size() - 1);
+  dynamic_.push_back(id);
+  return id;
+}
+
+void Scene::update(double time_s) {
+  for (ObjectId id : dynamic_) {
+    Object& o = objects_[id];
+    o.transform = motions_[o.motion].transform_at(time_s) * dynamic_local_[o.motion];
+    o.bounds = transform_box(mesh_bounds_[o.mesh], o.transform);
+  }
+}
+
+std::uint64_t Scene::triangle_count() const noexcept {
+  std::uint64_t n = 0;
+  for (const auto& o : objects_) n += o.triangles;
+  return n;
+}
+
+Aabb Scene::bounds() const noexcept {
+  Aabb b;
+  for (const auto& o : objects_) b.extend(o.bounds);
+  return b;
+}
+
+}  // namespace occull

@@ -1,0 +1,63 @@
+#include "occull/view.hpp"
+
+#include <glm/gtc/constants.hpp>
+#include <glm/gtc/matrix_transform.hpp>
+
+#include <algorithm>
+#include <cassert>
+#include <cmath>
+
+namespace occull {
+
+View make_view(const CameraPose& pose, const Lens& lens, int width, int height) {
+  assert(width > 0 && height > 0);
+  View v;
+  v.eye = pose.position;
+  const float cp = std::cos(pose.pitch);
+  const glm::vec3 forward(-std::sin(pose.yaw) * cp, std::sin(pose.pitch), -std::cos(pose.yaw) * cp);
+  v.view = glm::lookAt(pose.position, pose.position + forward, glm::vec3(0, 1, 0));
+  v.proj = glm::perspective(glm::radians(lens.fov_y_degrees), float(width) / float(height),
+                            lens.near, lens.far);
+  v.view_proj = v.proj * v.view;
+  v.frustum = Frustum::from_view_projection(v.view_proj);
+  v.width = width;
+  v.height = height;
+  v.near = lens.near;
+  v.far = lens.far;
+  return v;
+}
+
+CameraPath::CameraPath(std::string name, std::string description, std::vector<Key> keys)
+    : name_(std::move(name)), description_(std::move(description)), keys_(std::move(keys)) {
+  assert(!keys_.empty());
+}
+
+double CameraPath::duration() const noexcept {
+  return keys_.empty() ? 0.0 : keys_.back().time - keys_.front().time;
+}
+
+double CameraPath::frame_time(int k, int frames) const noexcept {
+  if (keys_.empty()) return 0.0;
+  if (frames <= 1) return keys_.front().time;
+  return keys_.front().time + duration() * double(k) / double(frames - 1);
+}
+
+CameraPose CameraPath::sample(double t) const {
+  assert(!keys_.empty());
+  if (t <= keys_.front().time) return keys_.front().pose;
+  if (t >= keys_.back().time) return keys_.back().pose;
+  const auto it = std::upper_bound(keys_.begin(), keys_.end(), t,
+                                   [](double time, const Key& k) { return time < k.time; });
+  const Key& b = *it;
+  const Key& a = *(it - 1);
+  if (b.cut) return a.pose;  // hold until the jump
+  const float f = float((t - a.time) / (b.time - a.time));
+  CameraPose p;
+  p.position = glm::mix(a.pose.position, b.pose.position, f);
+  float dyaw = std::remainder(b.pose.yaw - a.pose.yaw, glm::two_pi<float>());
+  p.yaw = a.pose.yaw + dyaw * f;
+  p.pitch = glm::mix(a.pose.pitch, b.pose.pitch, f);
+  return p;
+}
+
+}  // namespace occull

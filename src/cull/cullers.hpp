@@ -1,0 +1,13 @@
+// Internal: the factory of each algorithm (one file per algorithm).
+#pragma once
+
+#include "occull/culler.hpp"
+
+#include <memory>
+
+namespace occull::detail {
+
+std::unique_ptr<Culler> make_none(const SceneIndex& index, const Options& options);
+std::unique_ptr<Culler> make_vfc(const SceneIndex& index, const Options& options);
+
+}  // namespace occull::detail

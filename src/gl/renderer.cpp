@@ -1,0 +1,593 @@
+#include "occull/gl/renderer.hpp"
+
+#include "gl.hpp"
+
+#include <glm/gtc/type_ptr.hpp>
+
+#include <algorithm>
+#include <cassert>
+#include <chrono>
+#include <stdexcept>
+
+namespace occull::gl {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double ms_since(Clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+}
+
+// Adds the wall time of the enclosing scope to a counter.
+class ScopedTimer {
+ public:
+  explicit ScopedTimer(double& sink) : sink_(sink), t0_(Clock::now()) {}
+  ~ScopedTimer() { sink_ += ms_since(t0_); }
+  ScopedTimer(const ScopedTimer&) = delete;
+  ScopedTimer& operator=(const ScopedTimer&) = delete;
+
+ private:
+  double& sink_;
+  Clock::time_point t0_;
+};
+
+const char* kSceneVertex = R"(#version 450 core
+layout(location = 0) in vec3 a_position;
+layout(location = 1) in vec3 a_normal;
+layout(location = 2) in uint a_object;
+layout(std430, binding = 0) readonly buffer Objects { mat4 models[]; };
+uniform mat4 u_view_proj;
+out vec3 v_world;
+out vec3 v_normal;
+flat out uint v_object;
+void main() {
+  mat4 m = models[a_object];
+  vec4 world = m * vec4(a_position, 1.0);
+  v_world = world.xyz;
+  v_normal = mat3(m) * a_normal;
+  v_object = a_object;
+  gl_Position = u_view_proj * world;
+}
+)";
+
+// Shading cost: `lights` extra point lights, placed around the fragment by a
+// fixed pattern, each evaluated with a full Blinn-Phong term.
+const char* kSceneFragment = R"(#version 450 core
+struct MaterialData { vec4 color; ivec4 params; };
+layout(std430, binding = 1) readonly buffer Materials { MaterialData materials[]; };
+uniform uint u_material;
+uniform vec3 u_eye;
+uniform vec3 u_background;
+uniform float u_fog_distance;
+in vec3 v_world;
+in vec3 v_normal;
+flat in uint v_object;
+layout(location = 0) out vec4 o_color;
+layout(location = 1) out uint o_id;
+void main() {
+  MaterialData m = materials[u_material];
+  vec3 n = normalize(v_normal);
+  vec3 to_eye = normalize(u_eye - v_world);
+  const vec3 sun = normalize(vec3(0.45, 0.8, 0.35));
+  float diffuse = max(dot(n, sun), 0.0);
+  float sky = 0.5 + 0.5 * n.y;
+  vec3 c = m.color.rgb * (0.25 + 0.25 * sky + 0.6 * diffuse);
+  for (int i = 0; i < m.params.x; ++i) {
+    float fi = float(i);
+    vec3 light = v_world + vec3(sin(fi * 1.7) * 8.0, 4.0 + 2.0 * cos(fi * 2.3), cos(fi * 1.3) * 8.0);
+    vec3 l = light - v_world;
+    float d2 = dot(l, l);
+    l *= inversesqrt(d2);
+    vec3 h = normalize(l + to_eye);
+    float spec = pow(max(dot(n, h), 0.0), 32.0);
+    c += (m.color.rgb * max(dot(n, l), 0.0) + vec3(spec)) * (0.4 / (1.0 + 0.08 * d2)) /
+         float(m.params.x);
+  }
+  float fog = clamp(length(u_eye - v_world) / u_fog_distance, 0.0, 1.0);
+  c = mix(c, u_background, fog * fog * 0.6);
+  o_color = vec4(c, m.color.a);
+  o_id = v_object + 1u;
+}
+)";
+
+const char* kQueryVertex = R"(#version 450 core
+layout(location = 0) in vec3 a_corner;
+layout(location = 3) in vec3 a_min;
+layout(location = 4) in vec3 a_max;
+uniform mat4 u_view_proj;
+void main() { gl_Position = u_view_proj * vec4(mix(a_min, a_max, a_corner), 1.0); }
+)";
+
+const char* kQueryFragment = R"(#version 450 core
+void main() {}
+)";
+
+struct MeshRange {
+  GLsizei index_count = 0;
+  std::size_t first_index = 0;
+  GLint base_vertex = 0;
+};
+
+struct alignas(16) MaterialData {
+  glm::vec4 color;
+  glm::ivec4 params;
+};
+
+GLenum query_target(QueryMode mode) {
+  switch (mode) {
+    case QueryMode::any_samples_passed: return GL_ANY_SAMPLES_PASSED;
+    case QueryMode::any_samples_passed_conservative: return GL_ANY_SAMPLES_PASSED_CONSERVATIVE;
+    case QueryMode::samples_passed: break;
+  }
+  return GL_SAMPLES_PASSED;
+}
+
+constexpr GLsizeiptr kBoxCapacity = 1 << 16;  // boxes per stream-buffer fill
+
+}  // namespace
+
+struct Renderer::Impl {
+  const Scene& scene;
+  RendererOptions options;
+  GLenum target = GL_SAMPLES_PASSED;
+
+  GLuint vertex_buffer = 0, index_buffer = 0, object_index_buffer = 0;
+  GLuint object_buffer = 0, material_buffer = 0;
+  GLuint scene_vao = 0, scene_program = 0;
+  GLint u_scene_view_proj = -1, u_material = -1, u_eye = -1, u_background = -1, u_fog = -1;
+  GLuint cube_vertices = 0, cube_indices = 0, box_buffer = 0;
+  GLuint query_vao = 0, query_program = 0;
+  GLint u_query_view_proj = -1;
+  GLuint fbo = 0, color_rb = 0, depth_rb = 0, id_rb = 0;
+  GLuint timer = 0;
+  bool timer_supported = false;
+  bool write_ids = true;
+
+  std::vector<MeshRange> meshes;
+  std::vector<GLuint> query_names;  // QueryId -> GL name (all of `target`)
+  std::vector<QueryId> free_queries;
+  std::size_t in_flight = 0;
+  GLsizeiptr box_offset = 0;  // next free box in the stream buffer
+
+  enum class Mode { none, render, query } mode = Mode::none;
+  MaterialId bound_material = ~0u;
+  glm::vec3 eye{0.0f};
+  std::vector<ObjectId> opaque;
+  std::vector<ObjectId> translucent;  // deferred to end_frame
+
+  Impl(const Scene& s, const RendererOptions& o) : scene(s), options(o) {}
+
+  void create_targets();
+  void create_scene_buffers();
+  void create_query_resources();
+  void apply_draw_buffers() const;
+  void enter_render_state(BackendStats& stats);
+  void enter_query_state(BackendStats& stats);
+  void draw_objects(std::span<const ObjectId> ids, BackendStats& stats);
+  void upload_dynamic_transforms();
+};
+
+void Renderer::Impl::create_targets() {
+  glCreateRenderbuffers(1, &color_rb);
+  glNamedRenderbufferStorage(color_rb, GL_RGBA8, options.width, options.height);
+  glCreateRenderbuffers(1, &depth_rb);
+  glNamedRenderbufferStorage(depth_rb, GL_DEPTH_COMPONENT32F, options.width, options.height);
+  glCreateRenderbuffers(1, &id_rb);
+  glNamedRenderbufferStorage(id_rb, GL_R32UI, options.width, options.height);
+  glCreateFramebuffers(1, &fbo);
+  glNamedFramebufferRenderbuffer(fbo, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, color_rb);
+  glNamedFramebufferRenderbuffer(fbo, GL_COLOR_ATTACHMENT1, GL_RENDERBUFFER, id_rb);
+  glNamedFramebufferRenderbuffer(fbo, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, depth_rb);
+  apply_draw_buffers();
+  const GLenum status = glCheckNamedFramebufferStatus(fbo, GL_FRAMEBUFFER);
+  if (status != GL_FRAMEBUFFER_COMPLETE)
+    throw std::runtime_error("occull renderer: offscreen framebuffer incomplete (status 0x" +
+                             std::to_string(status) + ")");
+}
+
+void Renderer::Impl::apply_draw_buffers() const {
+  const GLenum both[] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
+  const GLenum color_only[] = {GL_COLOR_ATTACHMENT0, GL_NONE};
+  glNamedFramebufferDrawBuffers(fbo, 2, write_ids ? both : color_only);
+}
+
+void Renderer::Impl::create_scene_buffers() {
+  // One interleaved vertex buffer and one index buffer for every mesh.
+  std::size_t vertex_count = 0, index_count = 0;
+  for (const Mesh& m : scene.meshes()) {
+    vertex_count += m.positions.size();
+    index_count += m.indices.size();
+  }
+  std::vector<float> vertices;
+  vertices.reserve(vertex_count * 6);
+  std::vector<std::uint32_t> indices;
+  indices.reserve(index_count);
+  for (const Mesh& m : scene.meshes()) {
+    MeshRange r;
+    r.index_count = GLsizei(m.indices.size());
+    r.first_index = indices.size();
+    r.base_vertex = GLint(vertices.size() / 6);
+    for (std::size_t i = 0; i < m.positions.size(); ++i) {
+      vertices.insert(vertices.end(), {m.positions[i].x, m.positions[i].y, m.positions[i].z,
+                                       m.normals[i].x, m.normals[i].y, m.normals[i].z});
+    }
+    indices.insert(indices.end(), m.indices.begin(), m.indices.end());
+    meshes.push_back(r);
+  }
+  glCreateBuffers(1, &vertex_buffer);
+  glNamedBufferStorage(vertex_buffer, GLsizeiptr(std::max<std::size_t>(vertices.size(), 1) * 4),
+                       vertices.empty() ? nullptr : vertices.data(), 0);
+  glCreateBuffers(1, &index_buffer);
+  glNamedBufferStorage(index_buffer, GLsizeiptr(std::max<std::size_t>(indices.size(), 1) * 4),
+                       indices.empty() ? nullptr : indices.data(), 0);
+
+  // Object index per instance: drawing object i with base instance i makes
+  // the vertex shader see a_object == i.
+  const auto objects = scene.objects();
+  std::vector<std::uint32_t> object_index(std::max<std::size_t>(objects.size(), 1));
+  for (std::uint32_t i = 0; i < object_index.size(); ++i) object_index[i] = i;
+  glCreateBuffers(1, &object_index_buffer);
+  glNamedBufferStorage(object_index_buffer, GLsizeiptr(object_index.size() * 4),
+                       object_index.data(), 0);
+
+  std::vector<glm::mat4> models(std::max<std::size_t>(objects.size(), 1), glm::mat4(1.0f));
+  for (std::size_t i = 0; i < objects.size(); ++i) models[i] = objects[i].transform;
+  glCreateBuffers(1, &object_buffer);
+  glNamedBufferStorage(object_buffer, GLsizeiptr(models.size() * sizeof(glm::mat4)), models.data(),
+                       GL_DYNAMIC_STORAGE_BIT);
+
+  std::vector<MaterialData> materials;
+  for (const Material& m : scene.materials()) {
+    glm::vec4 color = m.color;
+    if (!m.translucent) color.a = 1.0f;
+    materials.push_back({color, glm::ivec4(std::max(0, m.shading_cost), 0, 0, 0)});
+  }
+  if (materials.empty()) materials.push_back({glm::vec4(1.0f), glm::ivec4(0)});
+  glCreateBuffers(1, &material_buffer);
+  glNamedBufferStorage(material_buffer, GLsizeiptr(materials.size() * sizeof(MaterialData)),
+                       materials.data(), 0);
+
+  glCreateVertexArrays(1, &scene_vao);
+  glVertexArrayVertexBuffer(scene_vao, 0, vertex_buffer, 0, 6 * sizeof(float));
+  glVertexArrayAttribFormat(scene_vao, 0, 3, GL_FLOAT, GL_FALSE, 0);
+  glVertexArrayAttribFormat(scene_vao, 1, 3, GL_FLOAT, GL_FALSE, 3 * sizeof(float));
+  glVertexArrayAttribBinding(scene_vao, 0, 0);
+  glVertexArrayAttribBinding(scene_vao, 1, 0);
+  glEnableVertexArrayAttrib(scene_vao, 0);
+  glEnableVertexArrayAttrib(scene_vao, 1);
+  glVertexArrayVertexBuffer(scene_vao, 1, object_index_buffer, 0, sizeof(std::uint32_t));
+  glVertexArrayBindingDivisor(scene_vao, 1, 1);
+  glVertexArrayAttribIFormat(scene_vao, 2, 1, GL_UNSIGNED_INT, 0);
+  glVertexArrayAttribBinding(scene_vao, 2, 1);
+  glEnableVertexArrayAttrib(scene_vao, 2);
+  glVertexArrayElementBuffer(scene_vao, index_buffer);
+
+  scene_program = make_program("scene", kSceneVertex, kSceneFragment);
+  u_scene_view_proj = glGetUniformLocation(scene_program, "u_view_proj");
+  u_material = glGetUniformLocation(scene_program, "u_material");
+  u_eye = glGetUniformLocation(scene_program, "u_eye");
+  u_background = glGetUniformLocation(scene_program, "u_background");
+  u_fog = glGetUniformLocation(scene_program, "u_fog_distance");
+}
+
+void Renderer::Impl::create_query_resources() {
+  // Unit cube: corner i has bit 0 = x, bit 1 = y, bit 2 = z (as Aabb::corner).
+  float corners[8 * 3];
+  for (int i = 0; i < 8; ++i) {
+    corners[i * 3 + 0] = float(i & 1);
+    corners[i * 3 + 1] = float((i >> 1) & 1);
+    corners[i * 3 + 2] = float((i >> 2) & 1);
+  }
+  // Outward counter-clockwise faces (winding matters only for consistency:
+  // query boxes are drawn without face culling).
+  const GLubyte idx[36] = {0, 2, 3, 0, 3, 1,  4, 5, 7, 4, 7, 6,  0, 4, 6, 0, 6, 2,
+                           1, 3, 7, 1, 7, 5,  0, 1, 5, 0, 5, 4,  2, 6, 7, 2, 7, 3};
+  glCreateBuffers(1, &cube_vertices);
+  glNamedBufferStorage(cube_vertices, sizeof(corners), corners, 0);
+  glCreateBuffers(1, &cube_indices);
+  glNamedBufferStorage(cube_indices, sizeof(idx), idx, 0);
+  glCreateBuffers(1, &box_buffer);
+  glNamedBufferData(box_buffer, kBoxCapacity * GLsizeiptr(sizeof(Aabb)), nullptr, GL_STREAM_DRAW);
+  static_assert(sizeof(Aabb) == 6 * sizeof(float), "Aabb is uploaded as two vec3");
+
+  glCreateVertexArrays(1, &query_vao);
+  glVertexArrayVertexBuffer(query_vao, 0, cube_vertices, 0, 3 * sizeof(float));
+  glVertexArrayAttribFormat(query_vao, 0, 3, GL_FLOAT, GL_FALSE, 0);
+  glVertexArrayAttribBinding(query_vao, 0, 0);
+  glEnableVertexArrayAttrib(query_vao, 0);
+  glVertexArrayVertexBuffer(query_vao, 1, box_buffer, 0, sizeof(Aabb));
+  glVertexArrayBindingDivisor(query_vao, 1, 1);
+  glVertexArrayAttribFormat(query_vao, 3, 3, GL_FLOAT, GL_FALSE, 0);
+  glVertexArrayAttribFormat(query_vao, 4, 3, GL_FLOAT, GL_FALSE, 3 * sizeof(float));
+  glVertexArrayAttribBinding(query_vao, 3, 1);
+  glVertexArrayAttribBinding(query_vao, 4, 1);
+  glEnableVertexArrayAttrib(query_vao, 3);
+  glEnableVertexArrayAttrib(query_vao, 4);
+  glVertexArrayElementBuffer(query_vao, cube_indices);
+
+  query_program = make_program("query", kQueryVertex, kQueryFragment);
+  u_query_view_proj = glGetUniformLocation(query_program, "u_view_proj");
+
+  GLint bits = 0;
+  glGetQueryiv(GL_TIME_ELAPSED, GL_QUERY_COUNTER_BITS, &bits);
+  timer_supported = bits > 0;
+  if (timer_supported) glCreateQueries(GL_TIME_ELAPSED, 1, &timer);
+}
+
+void Renderer::Impl::enter_render_state(BackendStats& stats) {
+  if (mode == Mode::render) return;
+  if (mode == Mode::query) ++stats.state_changes;
+  mode = Mode::render;
+  glUseProgram(scene_program);
+  glBindVertexArray(scene_vao);
+  glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+  glDepthMask(GL_TRUE);
+  glDepthFunc(GL_LESS);
+  glDisable(GL_DEPTH_CLAMP);
+  glDisable(GL_POLYGON_OFFSET_FILL);
+  if (options.cull_backfaces) glEnable(GL_CULL_FACE);
+}
+
+void Renderer::Impl::enter_query_state(BackendStats& stats) {
+  if (mode == Mode::query) return;
+  if (mode == Mode::render) ++stats.state_changes;
+  mode = Mode::query;
+  glUseProgram(query_program);
+  glBindVertexArray(query_vao);
+  glColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
+  glDepthMask(GL_FALSE);
+  glDepthFunc(GL_LEQUAL);
+  glEnable(GL_DEPTH_CLAMP);
+  glEnable(GL_POLYGON_OFFSET_FILL);
+  glPolygonOffset(-1.0f, -1.0f);
+  glDisable(GL_CULL_FACE);
+}
+
+void Renderer::Impl::draw_objects(std::span<const ObjectId> ids, BackendStats& stats) {
+  enter_render_state(stats);
+  for (ObjectId id : ids) {
+    const Object& o = scene.object(id);
+    if (o.material != bound_material) {
+      glUniform1ui(u_material, o.material);
+      bound_material = o.material;
+      ++stats.material_changes;
+    }
+    const MeshRange& r = meshes[o.mesh];
+    glDrawElementsInstancedBaseVertexBaseInstance(
+        GL_TRIANGLES, r.index_count, GL_UNSIGNED_INT,
+        reinterpret_cast<const void*>(r.first_index * sizeof(std::uint32_t)), 1, r.base_vertex,
+        id);
+    ++stats.draw_calls;
+    ++stats.objects_rendered;
+    stats.triangles += o.triangles;
+  }
+}
+
+void Renderer::Impl::upload_dynamic_transforms() {
+  for (ObjectId id : scene.dynamic_objects()) {
+    glNamedBufferSubData(object_buffer, GLintptr(id * sizeof(glm::mat4)), sizeof(glm::mat4),
+                         glm::value_ptr(scene.object(id).transform));
+  }
+}
+
+Renderer::Renderer(const Scene& scene, const RendererOptions& options)
+    : impl_(std::make_unique<Impl>(scene, options)) {
+  assert(options.width > 0 && options.height > 0);
+  impl_->target = query_target(options.query_mode);
+  impl_->write_ids = options.write_ids;
+  impl_->create_targets();
+  impl_->create_scene_buffers();
+  impl_->create_query_resources();
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, impl_->object_buffer);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, impl_->material_buffer);
+  glEnable(GL_DEPTH_TEST);
+  glFrontFace(GL_CCW);
+  glCullFace(GL_BACK);
+  check_error("creating the renderer");
+}
+
+Renderer::~Renderer() {
+  Impl& g = *impl_;
+  if (!g.query_names.empty())
+    glDeleteQueries(GLsizei(g.query_names.size()), g.query_names.data());
+  if (g.timer) glDeleteQueries(1, &g.timer);
+  const GLuint buffers[] = {g.vertex_buffer, g.index_buffer, g.object_index_buffer,
+                            g.object_buffer, g.material_buffer, g.cube_vertices,
+                            g.cube_indices,  g.box_buffer};
+  glDeleteBuffers(GLsizei(std::size(buffers)), buffers);
+  const GLuint vaos[] = {g.scene_vao, g.query_vao};
+  glDeleteVertexArrays(2, vaos);
+  glDeleteProgram(g.scene_program);
+  glDeleteProgram(g.query_program);
+  glDeleteFramebuffers(1, &g.fbo);
+  const GLuint rbs[] = {g.color_rb, g.depth_rb, g.id_rb};
+  glDeleteRenderbuffers(3, rbs);
+}
+
+void Renderer::begin_frame(const View& view) {
+  Impl& g = *impl_;
+  glBindFramebuffer(GL_FRAMEBUFFER, g.fbo);
+  glViewport(0, 0, g.options.width, g.options.height);
+  glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+  glDepthMask(GL_TRUE);
+  const glm::vec4 bg(g.options.background, 1.0f);
+  glClearNamedFramebufferfv(g.fbo, GL_COLOR, 0, glm::value_ptr(bg));
+  const GLuint zero[4] = {0, 0, 0, 0};
+  if (g.write_ids) glClearNamedFramebufferuiv(g.fbo, GL_COLOR, 1, zero);
+  const float one = 1.0f;
+  glClearNamedFramebufferfv(g.fbo, GL_DEPTH, 0, &one);
+
+  g.upload_dynamic_transforms();
+  glProgramUniformMatrix4fv(g.scene_program, g.u_scene_view_proj, 1, GL_FALSE,
+                            glm::value_ptr(view.view_proj));
+  glProgramUniformMatrix4fv(g.query_program, g.u_query_view_proj, 1, GL_FALSE,
+                            glm::value_ptr(view.view_proj));
+  glProgramUniform3fv(g.scene_program, g.u_eye, 1, glm::value_ptr(view.eye));
+  glProgramUniform3fv(g.scene_program, g.u_background, 1, glm::value_ptr(g.options.background));
+  glProgramUniform1f(g.scene_program, g.u_fog, std::max(view.far, 1.0f));
+  g.eye = view.eye;
+  g.translucent.clear();
+  g.bound_material = ~0u;
+  // Start every frame in render state without counting it as a change.
+  g.mode = Impl::Mode::none;
+  BackendStats ignored;
+  g.enter_render_state(ignored);
+  // Fresh storage for this frame's query boxes (orphaning: the previous
+  // frame's draws keep their copy).
+  glNamedBufferData(g.box_buffer, kBoxCapacity * GLsizeiptr(sizeof(Aabb)), nullptr, GL_STREAM_DRAW);
+  g.box_offset = 0;
+  if (g.timer_supported) glBeginQuery(GL_TIME_ELAPSED, g.timer);
+}
+
+double Renderer::end_frame() {
+  Impl& g = *impl_;
+  if (!g.translucent.empty()) {
+    // Back to front by distance of the box centre; no depth or id writes.
+    std::sort(g.translucent.begin(), g.translucent.end(), [&](ObjectId a, ObjectId b) {
+      const glm::vec3 da = g.scene.object(a).bounds.center() - g.eye;
+      const glm::vec3 db = g.scene.object(b).bounds.center() - g.eye;
+      return glm::dot(da, da) > glm::dot(db, db);
+    });
+    g.enter_render_state(stats_);
+    glDepthMask(GL_FALSE);
+    glColorMaski(1, GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
+    glEnable(GL_BLEND);
+    glBlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
+    g.draw_objects(g.translucent, stats_);
+    glDisable(GL_BLEND);
+    glColorMaski(1, GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+    glDepthMask(GL_TRUE);
+    g.translucent.clear();
+  }
+  if (g.timer_supported) glEndQuery(GL_TIME_ELAPSED);
+  glFinish();
+  double gpu_ms = 0.0;
+  if (g.timer_supported) {
+    GLuint64 ns = 0;
+    glGetQueryObjectui64v(g.timer, GL_QUERY_RESULT, &ns);
+    gpu_ms = double(ns) * 1e-6;
+  }
+  check_error("end of frame");
+  return gpu_ms;
+}
+
+void Renderer::render(std::span<const ObjectId> objects) {
+  Impl& g = *impl_;
+  ScopedTimer timer(stats_.backend_ms);
+  ++stats_.render_flushes;
+  g.opaque.clear();
+  for (ObjectId id : objects) {
+    if (g.scene.material(g.scene.object(id).material).translucent)
+      g.translucent.push_back(id);
+    else
+      g.opaque.push_back(id);
+  }
+  std::stable_sort(g.opaque.begin(), g.opaque.end(), [&](ObjectId a, ObjectId b) {
+    return g.scene.object(a).material < g.scene.object(b).material;
+  });
+  if (!g.opaque.empty()) g.draw_objects(g.opaque, stats_);
+}
+
+QueryId Renderer::issue_query(std::span<const Aabb> boxes) {
+  Impl& g = *impl_;
+  assert(!boxes.empty());
+  ScopedTimer timer(stats_.backend_ms);
+  g.enter_query_state(stats_);
+  QueryId q;
+  if (g.free_queries.empty()) {
+    GLuint name = 0;
+    glCreateQueries(g.target, 1, &name);
+    q = QueryId(g.query_names.size());
+    g.query_names.push_back(name);
+  } else {
+    q = g.free_queries.back();
+    g.free_queries.pop_back();
+  }
+  ++g.in_flight;
+  const GLuint name = g.query_names[q];
+  glBeginQuery(g.target, name);
+  std::size_t done = 0;
+  while (done < boxes.size()) {
+    if (g.box_offset == kBoxCapacity) {
+      glNamedBufferData(g.box_buffer, kBoxCapacity * GLsizeiptr(sizeof(Aabb)), nullptr,
+                        GL_STREAM_DRAW);
+      g.box_offset = 0;
+    }
+    const auto n = std::min<std::size_t>(boxes.size() - done, std::size_t(kBoxCapacity - g.box_offset));
+    glNamedBufferSubData(g.box_buffer, g.box_offset * GLsizeiptr(sizeof(Aabb)),
+                         GLsizeiptr(n * sizeof(Aabb)), boxes.data() + done);
+    glDrawElementsInstancedBaseInstance(GL_TRIANGLES, 36, GL_UNSIGNED_BYTE, nullptr, GLsizei(n),
+                                        GLuint(g.box_offset));
+    g.box_offset += GLsizeiptr(n);
+    done += n;
+  }
+  glEndQuery(g.target);
+  ++stats_.queries;
+  stats_.query_boxes += boxes.size();
+  return q;
+}
+
+bool Renderer::result_available(QueryId q) {
+  Impl& g = *impl_;
+  ScopedTimer timer(stats_.backend_ms);
+  GLuint available = GL_FALSE;
+  glGetQueryObjectuiv(g.query_names[q], GL_QUERY_RESULT_AVAILABLE, &available);
+  return available == GL_TRUE;
+}
+
+std::uint64_t Renderer::result(QueryId q) {
+  Impl& g = *impl_;
+  const auto t0 = Clock::now();
+  GLuint64 samples = 0;
+  glGetQueryObjectui64v(g.query_names[q], GL_QUERY_RESULT, &samples);
+  const double ms = ms_since(t0);
+  stats_.wait_ms += ms;
+  stats_.backend_ms += ms;
+  g.free_queries.push_back(q);
+  --g.in_flight;
+  return samples;
+}
+
+void Renderer::flush() {
+  ScopedTimer timer(stats_.backend_ms);
+  glFlush();
+}
+
+void Renderer::set_write_ids(bool on) {
+  impl_->write_ids = on;
+  impl_->apply_draw_buffers();
+}
+
+std::vector<std::uint32_t> Renderer::read_ids() const {
+  const Impl& g = *impl_;
+  std::vector<std::uint32_t> ids(std::size_t(g.options.width) * std::size_t(g.options.height));
+  glNamedFramebufferReadBuffer(g.fbo, GL_COLOR_ATTACHMENT1);
+  glBindFramebuffer(GL_READ_FRAMEBUFFER, g.fbo);
+  glPixelStorei(GL_PACK_ALIGNMENT, 4);
+  glReadPixels(0, 0, g.options.width, g.options.height, GL_RED_INTEGER, GL_UNSIGNED_INT, ids.data());
+  check_error("reading the id buffer");
+  return ids;
+}
+
+std::vector<std::uint8_t> Renderer::read_rgba() const {
+  const Impl& g = *impl_;
+  const std::size_t row = std::size_t(g.options.width) * 4;
+  std::vector<std::uint8_t> pixels(row * std::size_t(g.options.height));
+  glNamedFramebufferReadBuffer(g.fbo, GL_COLOR_ATTACHMENT0);
+  glBindFramebuffer(GL_READ_FRAMEBUFFER, g.fbo);
+  glPixelStorei(GL_PACK_ALIGNMENT, 1);
+  glReadPixels(0, 0, g.options.width, g.options.height, GL_RGBA, GL_UNSIGNED_BYTE, pixels.data());
+  check_error("reading the colour buffer");
+  // GL's first row is the bottom one; images start at the top.
+  for (int y = 0; y < g.options.height / 2; ++y)
+    std::swap_ranges(pixels.begin() + long(std::size_t(y) * row),
+                     pixels.begin() + long(std::size_t(y + 1) * row),
+                     pixels.begin() + long(std::size_t(g.options.height - 1 - y) * row));
+  return pixels;
+}
+
+std::size_t Renderer::queries_in_flight() const noexcept { return impl_->in_flight; }
+int Renderer::width() const noexcept { return impl_->options.width; }
+int Renderer::height() const noexcept { return impl_->options.height; }
+
+}  // namespace occull::gl

@@ -1,0 +1,104 @@
+// Registry of the embedded scenes and parsing of scene specs.
+#include "occull/error.hpp"
+#include "scenes_internal.hpp"
+
+#include <fmt/format.h>
+
+#include <charconv>
+#include <cmath>
+
+namespace occull {
+namespace {
+
+struct Generator {
+  SceneInfo info;
+  SceneBundle (*make)(const scenes::Params&);
+};
+
+const std::vector<Generator>& generators() {
+  static const std::vector<Generator> all = {
+      {scenes::city_info(), &scenes::make_city},
+      {scenes::field_info(), &scenes::make_field},
+  };
+  return all;
+}
+
+std::string scene_names() {
+  std::string names;
+  for (const auto& g : generators()) names += (names.empty() ? "" : ", ") + g.info.name;
+  return names;
+}
+
+std::string param_names(const SceneInfo& info) {
+  std::string names;
+  for (const auto& p : info.params) names += (names.empty() ? "" : ", ") + p.key;
+  return names;
+}
+
+double parse_number(std::string_view text, const SceneInfo& info, const SceneParamInfo& p) {
+  double v = 0.0;
+  const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), v);
+  if (ec != std::errc() || end != text.data() + text.size() || !std::isfinite(v))
+    throw InputError(fmt::format("scene {}: parameter {}: '{}' is not a number", info.name, p.key, text));
+  if (p.integer && v != std::floor(v))
+    throw InputError(fmt::format("scene {}: parameter {}: '{}' is not a whole number", info.name,
+                                 p.key, text));
+  if (v < p.min || v > p.max)
+    throw InputError(fmt::format("scene {}: parameter {}: {} is outside [{}, {}]", info.name, p.key,
+                                 text, p.min, p.max));
+  return v;
+}
+
+}  // namespace
+
+std::span<const SceneInfo> embedded_scenes() {
+  static const std::vector<SceneInfo> infos = [] {
+    std::vector<SceneInfo> v;
+    for (const auto& g : generators()) v.push_back(g.info);
+    return v;
+  }();
+  return infos;
+}
+
+const CameraPath& SceneBundle::path(std::string_view name) const {
+  std::string names;
+  for (const auto& p : paths) {
+    if (p.name() == name) return p;
+    names += (names.empty() ? "" : ", ") + p.name();
+  }
+  throw InputError(fmt::format("unknown path '{}' for scene {}; valid paths: {}", name, scene.name(), names));
+}
+
+SceneBundle make_scene(std::string_view spec) {
+  const auto colon = spec.find(':');
+  const std::string_view name = spec.substr(0, colon);
+  const Generator* gen = nullptr;
+  for (const auto& g : generators())
+    if (g.info.name == name) gen = &g;
+  if (!gen)
+    throw InputError(fmt::format("unknown scene '{}'; valid scenes: {}", name, scene_names()));
+
+  scenes::Params params;
+  for (const auto& p : gen->info.params) params[p.key] = p.default_value;
+  std::string_view rest = colon == std::string_view::npos ? std::string_view{} : spec.substr(colon + 1);
+  while (!rest.empty()) {
+    const auto comma = rest.find(',');
+    const std::string_view item = rest.substr(0, comma);
+    rest = comma == std::string_view::npos ? std::string_view{} : rest.substr(comma + 1);
+    const auto eq = item.find('=');
+    if (eq == std::string_view::npos)
+      throw InputError(fmt::format("scene {}: '{}' is not key=value; parameters: {}", gen->info.name,
+                                   item, param_names(gen->info)));
+    const std::string_view key = item.substr(0, eq);
+    const SceneParamInfo* info = nullptr;
+    for (const auto& p : gen->info.params)
+      if (p.key == key) info = &p;
+    if (!info)
+      throw InputError(fmt::format("scene {}: unknown parameter '{}'; valid parameters: {}",
+                                   gen->info.name, key, param_names(gen->info)));
+    params[info->key] = parse_number(item.substr(eq + 1), gen->info, *info);
+  }
+  return gen->make(params);
+}
+
+}  // namespace occull
