@@ -1,1 +1,114 @@
+// Runs the occull tool and checks exit codes and messages.
 #include <gtest/gtest.h>
+
+#include <array>
+#include <cstdio>
+#include <fstream>
+#include <string>
+#include <sys/wait.h>
+
+namespace {
+
+struct CliRun {
+  int code = -1;
+  std::string output;  // stdout and stderr
+};
+
+CliRun run(const std::string& args) {
+  const std::string cmd = std::string(OCCULL_CLI) + " " + args + " 2>&1";
+  CliRun r;
+  FILE* pipe = popen(cmd.c_str(), "r");
+  if (!pipe) return r;
+  std::array<char, 4096> buf{};
+  while (std::fgets(buf.data(), int(buf.size()), pipe)) r.output += buf.data();
+  const int status = pclose(pipe);
+  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return r;
+}
+
+constexpr const char* kTinyCity = "--scene city:blocks=3,traffic=3 --size 64x48";
+
+}  // namespace
+
+TEST(Cli, HelpOnEveryCommandExitsZero) {
+  for (const char* cmd : {"", "info", "scenes", "algos", "bench", "render"}) {
+    const CliRun r = run(std::string(cmd) + " --help");
+    EXPECT_EQ(r.code, 0) << cmd << ": " << r.output;
+    EXPECT_NE(r.output.find("--help"), std::string::npos) << cmd;
+  }
+}
+
+TEST(Cli, NoCommandIsAUsageError) { EXPECT_EQ(run("").code, 2); }
+
+TEST(Cli, UnknownCommandIsAUsageError) { EXPECT_EQ(run("frobnicate").code, 2); }
+
+TEST(Cli, UnknownSceneListsValidScenes) {
+  const CliRun r = run("bench --scene town --frames 1");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.output.find("city, field"), std::string::npos) << r.output;
+}
+
+TEST(Cli, UnknownPathListsValidPaths) {
+  const CliRun r = run(std::string("bench ") + kTinyCity + " --path nowhere --frames 1 --algo vfc");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.output.find("street, flyover, turn"), std::string::npos) << r.output;
+}
+
+TEST(Cli, UnknownAlgorithmListsValidAlgorithms) {
+  const CliRun r = run(std::string("bench ") + kTinyCity + " --algo vfc,magic --frames 1");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.output.find("none, vfc"), std::string::npos) << r.output;
+}
+
+TEST(Cli, InvalidSizeIsRejected) {
+  for (const char* size : {"0x10", "12", "axb", "20000x10", "64x48x2"}) {
+    const CliRun r = run(std::string("bench --scene city:blocks=3 --algo vfc --frames 1 --size ") + size);
+    EXPECT_EQ(r.code, 2) << size << ": " << r.output;
+    EXPECT_NE(r.output.find("--size"), std::string::npos) << r.output;
+  }
+}
+
+TEST(Cli, InvalidFrameCountIsRejected) {
+  EXPECT_EQ(run(std::string("bench ") + kTinyCity + " --frames 0").code, 2);
+  EXPECT_EQ(run(std::string("bench ") + kTinyCity + " --frames many").code, 2);
+  EXPECT_EQ(run(std::string("render ") + kTinyCity + " --frame 7 --frames 5 --out /dev/null").code, 2);
+}
+
+TEST(Cli, UnknownOptionListsValidOptions) {
+  const CliRun r = run(std::string("bench ") + kTinyCity + " --algo vfc --frames 1 --opt vfc.speed=3");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.output.find("valid options"), std::string::npos) << r.output;
+}
+
+TEST(Cli, InfoNamesTheRenderer) {
+  const CliRun r = run("info");
+  EXPECT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("renderer"), std::string::npos);
+  EXPECT_NE(r.output.find("GL_SAMPLES_PASSED"), std::string::npos);
+}
+
+TEST(Cli, ScenesListsParametersPathsAndCounts) {
+  const CliRun r = run("scenes");
+  EXPECT_EQ(r.code, 0);
+  for (const char* s : {"city", "field", "blocks", "street", "flyover", "turn", "overview", "glide", "triangles"})
+    EXPECT_NE(r.output.find(s), std::string::npos) << s;
+}
+
+TEST(Cli, BenchPrintsATableRowPerAlgorithm) {
+  const CliRun r = run(std::string("bench ") + kTinyCity + " --algo none,vfc --frames 3 --warmup 1");
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("\nnone "), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("\nvfc "), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("median"), std::string::npos);
+}
+
+TEST(Cli, RenderWritesAPng) {
+  const std::string out = ::testing::TempDir() + "occull_cli_render.png";
+  std::remove(out.c_str());
+  const CliRun r = run(std::string("render ") + kTinyCity + " --frame 2 --frames 5 --out " + out);
+  ASSERT_EQ(r.code, 0) << r.output;
+  std::ifstream f(out, std::ios::binary);
+  char magic[8] = {};
+  f.read(magic, 8);
+  EXPECT_EQ(std::string(magic + 1, 3), "PNG");
+}

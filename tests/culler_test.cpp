@@ -1,1 +1,109 @@
+#include "occull/culler.hpp"
+#include "occull/error.hpp"
+#include "test_util.hpp"
+
 #include <gtest/gtest.h>
+
+#include <algorithm>
+#include <random>
+
+using namespace occull;
+
+namespace {
+
+Scene scattered(int n, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<float> pos(-100.0f, 100.0f);
+  std::vector<Aabb> boxes;
+  for (int i = 0; i < n; ++i) {
+    const glm::vec3 p(pos(rng), pos(rng) * 0.2f, pos(rng));
+    boxes.push_back({p, p + glm::vec3(2.0f)});
+  }
+  return test::box_scene(boxes);
+}
+
+}  // namespace
+
+TEST(Registry, KnowsNoneAndVfc) {
+  std::vector<std::string> names;
+  for (const auto& a : algorithms()) names.push_back(a.name);
+  EXPECT_NE(std::find(names.begin(), names.end(), "none"), names.end());
+  EXPECT_NE(std::find(names.begin(), names.end(), "vfc"), names.end());
+}
+
+TEST(Registry, UnknownAlgorithmListsTheValidOnes) {
+  const Scene scene = scattered(4, 1);
+  const Bvh bvh = Bvh::build(scene);
+  try {
+    (void)make_culler("nope", {scene, bvh});
+    FAIL() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("none, vfc"), std::string::npos) << e.what();
+  }
+}
+
+TEST(Options, RejectUnknownKeysAndBadValues) {
+  Options o;
+  EXPECT_THROW(o.set("nodot=3"), InputError);
+  EXPECT_THROW(o.set("vfc.x"), InputError);
+  o.set("vfc.bogus=1");
+  EXPECT_THROW(check_options(o), InputError);
+  Options other;
+  other.set("notanalgo.key=1");
+  EXPECT_THROW(check_options(other), InputError);
+  Options typed;
+  typed.set("a.n=12x");
+  typed.set("a.b=maybe");
+  typed.set("a.d=2.5");
+  EXPECT_THROW((void)typed.get_int("a.n", 0, 0, 100), InputError);
+  EXPECT_THROW((void)typed.get_bool("a.b", false), InputError);
+  EXPECT_DOUBLE_EQ(typed.get_double("a.d", 0, 0, 10), 2.5);
+  EXPECT_THROW((void)typed.get_double("a.d", 0, 0, 1), InputError);
+  EXPECT_EQ(typed.get_int("a.absent", 7, 0, 10), 7);
+}
+
+TEST(None, RendersEveryObject) {
+  const Scene scene = scattered(50, 2);
+  const Bvh bvh = Bvh::build(scene);
+  auto culler = make_culler("none", {scene, bvh});
+  test::RecordingBackend backend;
+  const View view = make_view({{0, 0, 0}, 0, 0}, {}, 64, 64);
+  culler->render_frame(view, backend);
+  EXPECT_EQ(backend.rendered.size(), 50u);
+  EXPECT_TRUE(backend.queried.empty());
+}
+
+TEST(Vfc, RendersExactlyTheObjectsNotOutsideTheFrustum) {
+  const Scene scene = scattered(2000, 3);
+  const Bvh bvh = Bvh::build(scene);
+  auto culler = make_culler("vfc", {scene, bvh});
+  for (float yaw : {0.0f, 1.0f, 2.5f, -2.0f}) {
+    const View view = make_view({{3, 1, -4}, yaw, 0.1f}, {60.0f, 0.1f, 80.0f}, 160, 90);
+    test::RecordingBackend backend;
+    const FrameStats stats = culler->render_frame(view, backend);
+    std::vector<ObjectId> expected;
+    for (ObjectId id = 0; id < scene.objects().size(); ++id)
+      if (view.frustum.classify(scene.object(id).bounds) != Containment::outside) expected.push_back(id);
+    std::vector<ObjectId> got = backend.rendered;
+    std::sort(got.begin(), got.end());
+    EXPECT_EQ(got, expected) << "yaw " << yaw;
+    EXPECT_TRUE(backend.queried.empty());
+    EXPECT_GT(stats.nodes_visited, 0u);
+    EXPECT_LT(stats.nodes_visited, bvh.size()) << "subtrees outside the frustum are skipped";
+  }
+}
+
+TEST(Vfc, RendersFrontToBackByNode) {
+  // A row of boxes along -Z: the nearest is rendered first.
+  std::vector<Aabb> row;
+  for (int i = 0; i < 32; ++i) row.push_back({{-1, -1, -5.0f - 4.0f * float(i)}, {1, 1, -3.0f - 4.0f * float(i)}});
+  const Scene scene = test::box_scene(row);
+  BvhOptions o;
+  o.max_leaf_objects = 1;
+  const Bvh bvh = Bvh::build(scene, o);
+  auto culler = make_culler("vfc", {scene, bvh});
+  test::RecordingBackend backend;
+  culler->render_frame(make_view({{0, 0, 0}, 0, 0}, {60.0f, 0.1f, 500.0f}, 64, 64), backend);
+  ASSERT_EQ(backend.rendered.size(), 32u);
+  for (std::size_t i = 0; i < 32; ++i) EXPECT_EQ(backend.rendered[i], ObjectId(i));
+}

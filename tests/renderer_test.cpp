@@ -1,1 +1,257 @@
+// GL integration tests: the reference renderer on llvmpipe (or any GL 4.5
+// driver), small frames.
+#include "occull/gl/context.hpp"
+#include "occull/gl/renderer.hpp"
+#include "occull/harness.hpp"
+#include "test_util.hpp"
+
 #include <gtest/gtest.h>
+
+#include <algorithm>
+#include <memory>
+#include <set>
+
+using namespace occull;
+
+namespace {
+
+constexpr int kSize = 128;
+
+// Camera at the origin looking down -Z; a 6 x 6 wall 10 m ahead hides a
+// small box 20 m ahead; another box 20 m ahead and 8 m right is in plain view.
+struct WallScene {
+  static constexpr ObjectId wall = 0, hidden = 1, beside = 2;
+  Scene scene = test::box_scene({{{-3, -3, -11}, {3, 3, -10}},
+                                 {{-1, -1, -21}, {1, 1, -19}},
+                                 {{7, -1, -21}, {9, 1, -19}}});
+  View view = make_view({{0, 0, 0}, 0, 0}, {60.0f, 0.1f, 100.0f}, kSize, kSize);
+};
+
+class RendererTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() { context_ = gl::Context::create(); }
+  static void TearDownTestSuite() { context_.reset(); }
+  static std::unique_ptr<gl::Context> context_;
+
+  static gl::RendererOptions small() {
+    gl::RendererOptions o;
+    o.width = kSize;
+    o.height = kSize;
+    return o;
+  }
+};
+std::unique_ptr<gl::Context> RendererTest::context_;
+
+std::set<ObjectId> ids_in(const std::vector<std::uint32_t>& pixels) {
+  std::set<ObjectId> ids;
+  for (std::uint32_t p : pixels)
+    if (p != 0) ids.insert(p - 1);
+  return ids;
+}
+
+}  // namespace
+
+TEST_F(RendererTest, ContextIsOpenGL45Core) {
+  const auto info = context_->info();
+  EXPECT_NE(info.version.find("4.5"), std::string::npos) << info.version;
+  EXPECT_GT(info.samples_passed_bits, 0);
+}
+
+TEST_F(RendererTest, BoxBehindOccluderHasNoSamplesAndVisibleBoxHasSome) {
+  WallScene w;
+  gl::Renderer r(w.scene, small());
+  r.begin_frame(w.view);
+  const ObjectId wall[] = {WallScene::wall};
+  r.render(wall);
+  const Aabb hidden[] = {w.scene.object(WallScene::hidden).bounds};
+  const Aabb beside[] = {w.scene.object(WallScene::beside).bounds};
+  const QueryId qh = r.issue_query(hidden);
+  const QueryId qb = r.issue_query(beside);
+  EXPECT_EQ(r.result(qh), 0u);
+  EXPECT_GT(r.result(qb), 0u);
+  r.end_frame();
+  EXPECT_EQ(r.queries_in_flight(), 0u);
+}
+
+TEST_F(RendererTest, MultiBoxQueryCountsTheUnion) {
+  WallScene w;
+  gl::Renderer r(w.scene, small());
+  r.begin_frame(w.view);
+  const ObjectId wall[] = {WallScene::wall};
+  r.render(wall);
+  const Aabb both[] = {w.scene.object(WallScene::hidden).bounds, w.scene.object(WallScene::beside).bounds};
+  const Aabb beside[] = {w.scene.object(WallScene::beside).bounds};
+  const QueryId q2 = r.issue_query(both);
+  const QueryId q1 = r.issue_query(beside);
+  EXPECT_EQ(r.result(q2), r.result(q1));
+  r.end_frame();
+  EXPECT_EQ(r.stats().query_boxes, 3u);
+}
+
+TEST_F(RendererTest, ThousandQueriesAllReadBackCorrectly) {
+  WallScene w;
+  gl::Renderer r(w.scene, small());
+  r.begin_frame(w.view);
+  const ObjectId wall[] = {WallScene::wall};
+  r.render(wall);
+  std::vector<QueryId> queries;
+  std::vector<bool> expect_visible;
+  for (int i = 0; i < 1000; ++i) {
+    // Small boxes 20 m away: even ones behind the wall, odd ones beside it.
+    const float x = (i % 2 == 0) ? -2.0f + 0.004f * float(i) : 6.0f + 0.002f * float(i);
+    const Aabb box[] = {{{x - 0.2f, -0.2f, -20.5f}, {x + 0.2f, 0.2f, -19.5f}}};
+    queries.push_back(r.issue_query(box));
+    expect_visible.push_back(i % 2 == 1);
+  }
+  for (std::size_t i = 0; i < queries.size(); ++i)
+    EXPECT_EQ(r.result(queries[i]) > 0, expect_visible[i]) << "query " << i;
+  r.end_frame();
+  EXPECT_EQ(r.stats().queries, 1000u);
+}
+
+TEST_F(RendererTest, ResultAvailableTurnsTrueAfterFinish) {
+  WallScene w;
+  gl::Renderer r(w.scene, small());
+  r.begin_frame(w.view);
+  const Aabb beside[] = {w.scene.object(WallScene::beside).bounds};
+  const QueryId q = r.issue_query(beside);
+  r.end_frame();  // glFinish: everything done
+  EXPECT_TRUE(r.result_available(q));
+  EXPECT_GT(r.result(q), 0u);
+}
+
+TEST_F(RendererTest, BoxCrossingTheNearPlaneIsVisible) {
+  WallScene w;
+  gl::Renderer r(w.scene, small());
+  r.begin_frame(w.view);
+  const ObjectId wall[] = {WallScene::wall};
+  r.render(wall);
+  // In front of the wall, its near face behind the eye's near plane.
+  const Aabb box[] = {{{-0.5f, -0.5f, -3.0f}, {0.5f, 0.5f, 0.05f}}};
+  const QueryId q = r.issue_query(box);
+  EXPECT_GT(r.result(q), 0u);
+  r.end_frame();
+}
+
+TEST_F(RendererTest, StateChangesCountSwitchesBetweenRenderingAndQuerying) {
+  WallScene w;
+  gl::Renderer r(w.scene, small());
+  r.begin_frame(w.view);
+  const ObjectId wall[] = {WallScene::wall};
+  const Aabb box[] = {w.scene.object(WallScene::beside).bounds};
+  r.render(wall);                       // already in render state: no change
+  const QueryId a = r.issue_query(box);  // 1
+  const QueryId b = r.issue_query(box);  // still querying
+  r.render(wall);                       // 2
+  r.result(a);
+  r.result(b);
+  r.end_frame();
+  EXPECT_EQ(r.stats().state_changes, 2u);
+  EXPECT_EQ(r.stats().render_flushes, 2u);
+  EXPECT_EQ(r.stats().draw_calls, 2u);
+  EXPECT_EQ(r.stats().triangles, 24u);
+}
+
+TEST_F(RendererTest, IdBufferHoldsTheVisibleObjects) {
+  WallScene w;
+  gl::Renderer r(w.scene, small());
+  r.begin_frame(w.view);
+  const ObjectId all[] = {0, 1, 2};
+  r.render(all);
+  r.end_frame();
+  const auto ids = r.read_ids();
+  ASSERT_EQ(ids.size(), std::size_t(kSize * kSize));
+  EXPECT_EQ(ids_in(ids), (std::set<ObjectId>{WallScene::wall, WallScene::beside}));
+  // The centre pixel shows the wall.
+  EXPECT_EQ(ids[std::size_t(kSize / 2 * kSize + kSize / 2)], WallScene::wall + 1);
+}
+
+TEST_F(RendererTest, ScreenshotHasTheObjectsOverTheBackground) {
+  WallScene w;
+  gl::RendererOptions o = small();
+  o.background = {0.0f, 0.0f, 1.0f};
+  gl::Renderer r(w.scene, o);
+  r.begin_frame(w.view);
+  const ObjectId all[] = {0, 1, 2};
+  r.render(all);
+  r.end_frame();
+  const auto rgba = r.read_rgba();
+  ASSERT_EQ(rgba.size(), std::size_t(kSize * kSize * 4));
+  std::size_t background = 0, object = 0;
+  for (std::size_t i = 0; i < rgba.size(); i += 4) {
+    if (rgba[i] == 0 && rgba[i + 1] == 0 && rgba[i + 2] == 255) ++background; else ++object;
+  }
+  // The wall spans about atan(3/10) of a 30 degree half-angle: ~ 33% x 33%... of the frame.
+  EXPECT_GT(object, std::size_t(kSize * kSize / 10));
+  EXPECT_GT(background, std::size_t(kSize * kSize / 2));
+  // Top-left corner is background; centre is an object (image rows start at the top).
+  EXPECT_EQ(rgba[2], 255);
+  const std::size_t centre = std::size_t((kSize / 2 * kSize + kSize / 2) * 4);
+  EXPECT_FALSE(rgba[centre] == 0 && rgba[centre + 1] == 0 && rgba[centre + 2] == 255);
+}
+
+TEST_F(RendererTest, TranslucentObjectsNeitherOccludeNorWriteIds) {
+  Scene scene("glass");
+  const MaterialId glass = scene.add_material({"glass", {0.5f, 0.8f, 1.0f, 0.3f}, true, 0});
+  const MaterialId grey = scene.add_material({"grey", {0.6f, 0.6f, 0.6f, 1.0f}, false, 0});
+  scene.add_object(scene.add_mesh(test::box_mesh({{-3, -3, -11}, {3, 3, -10}})), glass, glm::mat4(1),
+                   OccluderClass::never);
+  scene.add_object(scene.add_mesh(test::box_mesh({{-1, -1, -21}, {1, 1, -19}})), grey, glm::mat4(1),
+                   OccluderClass::always);
+  const View view = make_view({{0, 0, 0}, 0, 0}, {60.0f, 0.1f, 100.0f}, kSize, kSize);
+  gl::Renderer r(scene, small());
+  r.begin_frame(view);
+  const ObjectId glass_pane[] = {0};
+  r.render(glass_pane);
+  const Aabb behind[] = {scene.object(1).bounds};
+  const QueryId q = r.issue_query(behind);
+  EXPECT_GT(r.result(q), 0u) << "glass must not hide what is behind it";
+  const ObjectId box[] = {1};
+  r.render(box);
+  r.end_frame();
+  EXPECT_EQ(ids_in(r.read_ids()), std::set<ObjectId>{1});
+}
+
+TEST_F(RendererTest, DynamicObjectsAreDrawnWhereTheyAreNow) {
+  Scene scene("moving");
+  const MaterialId grey = scene.add_material({"grey", {0.6f, 0.6f, 0.6f, 1.0f}, false, 0});
+  Motion m;
+  m.waypoints = {{-30, 0, -20}, {30, 0, -20}};
+  m.speed = 1.0f;
+  scene.add_dynamic_object(scene.add_mesh(test::box_mesh({{-1, -1, -1}, {1, 1, 1}})), grey, m,
+                           OccluderClass::never);
+  const View view = make_view({{0, 0, 0}, 0, 0}, {60.0f, 0.1f, 100.0f}, kSize, kSize);
+  gl::Renderer r(scene, small());
+  const ObjectId obj[] = {0};
+  scene.update(0.0);  // far left: outside the view
+  r.begin_frame(view);
+  r.render(obj);
+  r.end_frame();
+  EXPECT_TRUE(ids_in(r.read_ids()).empty());
+  scene.update(30.0);  // straight ahead
+  r.begin_frame(view);
+  r.render(obj);
+  r.end_frame();
+  EXPECT_EQ(ids_in(r.read_ids()), std::set<ObjectId>{0});
+}
+
+TEST_F(RendererTest, QueryNamesAreReusedAfterResults) {
+  WallScene w;
+  gl::Renderer r(w.scene, small());
+  const Aabb box[] = {w.scene.object(WallScene::beside).bounds};
+  for (int frame = 0; frame < 3; ++frame) {
+    r.begin_frame(w.view);
+    for (int i = 0; i < 10; ++i) EXPECT_GT(r.result(r.issue_query(box)), 0u);
+    r.end_frame();
+  }
+  EXPECT_EQ(r.queries_in_flight(), 0u);
+}
+
+TEST_F(RendererTest, GpuTimeIsMeasured) {
+  WallScene w;
+  gl::Renderer r(w.scene, small());
+  r.begin_frame(w.view);
+  const ObjectId all[] = {0, 1, 2};
+  r.render(all);
+  EXPECT_GE(r.end_frame(), 0.0);
+}

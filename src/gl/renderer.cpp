@@ -339,7 +339,7 @@ void Renderer::Impl::enter_query_state(BackendStats& stats) {
   glDepthFunc(GL_LEQUAL);
   glEnable(GL_DEPTH_CLAMP);
   glEnable(GL_POLYGON_OFFSET_FILL);
-  glPolygonOffset(-1.0f, -1.0f);
+  glPolygonOffset(0.0f, -2.0f);  // units only: a slope term would pull edge-on faces through walls
   glDisable(GL_CULL_FACE);
 }
 

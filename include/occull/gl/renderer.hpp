@@ -41,9 +41,10 @@ struct RendererOptions {
 /// writing depth or ids: they never occlude.
 ///
 /// Queries: one shared unit cube drawn instanced, one instance per box, with
-/// colour and depth writes off, depth test LEQUAL, polygon offset towards the
-/// eye, depth clamping (a box crossing the near plane is not clipped away)
-/// and no face culling, so that a query never reports fewer samples than
+/// colour and depth writes off, depth test LEQUAL, a constant polygon offset
+/// of 2 depth units towards the eye (no slope term: it would pull edge-on
+/// faces through walls), depth clamping (a box crossing the near plane is
+/// not clipped away) and no face culling, so that a query never reports fewer samples than
 /// the box's visible surface has. Samples therefore count front and back
 /// faces where both pass.
 ///

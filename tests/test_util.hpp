@@ -1,0 +1,82 @@
+// Helpers shared by the tests: small constructed scenes and a Backend test
+// double that answers queries from a known visibility.
+#pragma once
+
+#include "occull/backend.hpp"
+#include "occull/scene.hpp"
+
+#include <glm/gtc/matrix_transform.hpp>
+
+#include <functional>
+#include <vector>
+
+namespace occull::test {
+
+/// A closed box mesh (12 triangles) spanning b, outward CCW faces.
+inline Mesh box_mesh(const Aabb& b) {
+  Mesh m;
+  const glm::vec3 n[6] = {{-1, 0, 0}, {1, 0, 0}, {0, -1, 0}, {0, 1, 0}, {0, 0, -1}, {0, 0, 1}};
+  for (int f = 0; f < 6; ++f) {
+    const int axis = f / 2;
+    const bool hi = f % 2;
+    const int u = (axis + 1) % 3, v = (axis + 2) % 3;
+    glm::vec3 p[4];
+    for (int k = 0; k < 4; ++k) {
+      glm::vec3 q;
+      q[axis] = hi ? b.max[axis] : b.min[axis];
+      q[u] = (k == 1 || k == 2) ? b.max[u] : b.min[u];
+      q[v] = (k >= 2) ? b.max[v] : b.min[v];
+      p[k] = q;
+    }
+    // (u, v) order is counter-clockwise seen from +axis.
+    const auto base = std::uint32_t(m.positions.size());
+    for (const auto& q : p) {
+      m.positions.push_back(q);
+      m.normals.push_back(n[f]);
+    }
+    if (hi)
+      m.indices.insert(m.indices.end(), {base, base + 1, base + 2, base, base + 2, base + 3});
+    else
+      m.indices.insert(m.indices.end(), {base, base + 2, base + 1, base, base + 3, base + 2});
+  }
+  return m;
+}
+
+/// A scene of axis-aligned boxes, one object (and mesh) each, in order.
+inline Scene box_scene(const std::vector<Aabb>& boxes, OccluderClass cls = OccluderClass::always) {
+  Scene s("boxes");
+  const MaterialId mat = s.add_material({"grey", {0.7f, 0.7f, 0.7f, 1.0f}, false, 0});
+  for (const Aabb& b : boxes) s.add_object(s.add_mesh(box_mesh(b)), mat, glm::mat4(1.0f), cls);
+  return s;
+}
+
+/// Backend double: records what was rendered and queried; a query's
+/// result comes from `visible_samples(boxes)` (default: 1 sample per box).
+class RecordingBackend final : public Backend {
+ public:
+  std::function<std::uint64_t(std::span<const Aabb>)> visible_samples =
+      [](std::span<const Aabb> b) { return std::uint64_t(b.size()); };
+  std::vector<ObjectId> rendered;
+  std::vector<std::vector<Aabb>> queried;
+
+  void render(std::span<const ObjectId> objects) override {
+    rendered.insert(rendered.end(), objects.begin(), objects.end());
+    ++stats_.render_flushes;
+    stats_.draw_calls += objects.size();
+  }
+  QueryId issue_query(std::span<const Aabb> boxes) override {
+    queried.emplace_back(boxes.begin(), boxes.end());
+    results_.push_back(visible_samples(boxes));
+    ++stats_.queries;
+    return QueryId(results_.size() - 1);
+  }
+  bool result_available(QueryId) override { return true; }
+  std::uint64_t result(QueryId q) override { return results_.at(q); }
+  [[nodiscard]] BackendStats stats() const override { return stats_; }
+
+ private:
+  std::vector<std::uint64_t> results_;
+  BackendStats stats_;
+};
+
+}  // namespace occull::test
