@@ -14,8 +14,9 @@ struct CliRun {
   std::string output;  // stdout and stderr
 };
 
-CliRun run(const std::string& args) {
-  const std::string cmd = std::string(OCCULL_CLI) + " " + args + " 2>&1";
+// `env` is prepended to the command line (e.g. "VAR=value").
+CliRun run(const std::string& args, const std::string& env = "") {
+  const std::string cmd = env + " " + std::string(OCCULL_CLI) + " " + args + " 2>&1";
   CliRun r;
   FILE* pipe = popen(cmd.c_str(), "r");
   if (!pipe) return r;
@@ -111,4 +112,18 @@ TEST(Cli, RenderWritesAPng) {
   char magic[8] = {};
   f.read(magic, 8);
   EXPECT_EQ(std::string(magic + 1, 3), "PNG");
+}
+
+TEST(Cli, MissingEglDriverExitsThreeWithAnInstallHint) {
+  // GLVND finds no EGL vendor library: as on a machine without Mesa's EGL.
+  const CliRun r = run("info", "__EGL_VENDOR_LIBRARY_FILENAMES=/nonexistent/vendor.json");
+  EXPECT_EQ(r.code, 3) << r.output;
+  EXPECT_NE(r.output.find("apt-get install"), std::string::npos) << r.output;
+}
+
+TEST(Cli, DriverWithoutOpenGL45ExitsThree) {
+  if (run("info").output.find("Mesa") == std::string::npos) GTEST_SKIP() << "needs a Mesa driver";
+  const CliRun r = run("info", "MESA_GL_VERSION_OVERRIDE=3.3");
+  EXPECT_EQ(r.code, 3) << r.output;
+  EXPECT_NE(r.output.find("4.5"), std::string::npos) << r.output;
 }
