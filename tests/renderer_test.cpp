@@ -42,6 +42,13 @@ class RendererTest : public ::testing::Test {
 };
 std::unique_ptr<gl::Context> RendererTest::context_;
 
+// Starts a frame of the wall scene with the wall already drawn.
+void begin_with_wall(gl::Renderer& r, const WallScene& w) {
+  r.begin_frame(w.view);
+  const ObjectId wall[] = {WallScene::wall};
+  r.render(wall);
+}
+
 std::set<ObjectId> ids_in(const std::vector<std::uint32_t>& pixels) {
   std::set<ObjectId> ids;
   for (std::uint32_t p : pixels)
@@ -60,9 +67,7 @@ TEST_F(RendererTest, ContextIsOpenGL45Core) {
 TEST_F(RendererTest, BoxBehindOccluderHasNoSamplesAndVisibleBoxHasSome) {
   WallScene w;
   gl::Renderer r(w.scene, small());
-  r.begin_frame(w.view);
-  const ObjectId wall[] = {WallScene::wall};
-  r.render(wall);
+  begin_with_wall(r, w);
   const Aabb hidden[] = {w.scene.object(WallScene::hidden).bounds};
   const Aabb beside[] = {w.scene.object(WallScene::beside).bounds};
   const QueryId qh = r.issue_query(hidden);
@@ -76,9 +81,7 @@ TEST_F(RendererTest, BoxBehindOccluderHasNoSamplesAndVisibleBoxHasSome) {
 TEST_F(RendererTest, MultiBoxQueryCountsTheUnion) {
   WallScene w;
   gl::Renderer r(w.scene, small());
-  r.begin_frame(w.view);
-  const ObjectId wall[] = {WallScene::wall};
-  r.render(wall);
+  begin_with_wall(r, w);
   const Aabb both[] = {w.scene.object(WallScene::hidden).bounds, w.scene.object(WallScene::beside).bounds};
   const Aabb beside[] = {w.scene.object(WallScene::beside).bounds};
   const QueryId q2 = r.issue_query(both);
@@ -91,9 +94,7 @@ TEST_F(RendererTest, MultiBoxQueryCountsTheUnion) {
 TEST_F(RendererTest, ThousandQueriesAllReadBackCorrectly) {
   WallScene w;
   gl::Renderer r(w.scene, small());
-  r.begin_frame(w.view);
-  const ObjectId wall[] = {WallScene::wall};
-  r.render(wall);
+  begin_with_wall(r, w);
   std::vector<QueryId> queries;
   std::vector<bool> expect_visible;
   for (int i = 0; i < 1000; ++i) {
@@ -123,9 +124,7 @@ TEST_F(RendererTest, ResultAvailableTurnsTrueAfterFinish) {
 TEST_F(RendererTest, BoxCrossingTheNearPlaneIsVisible) {
   WallScene w;
   gl::Renderer r(w.scene, small());
-  r.begin_frame(w.view);
-  const ObjectId wall[] = {WallScene::wall};
-  r.render(wall);
+  begin_with_wall(r, w);
   // In front of the wall, its near face behind the eye's near plane.
   const Aabb box[] = {{{-0.5f, -0.5f, -3.0f}, {0.5f, 0.5f, 0.05f}}};
   const QueryId q = r.issue_query(box);
