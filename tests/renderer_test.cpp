@@ -254,3 +254,27 @@ TEST_F(RendererTest, GpuTimeIsMeasured) {
   r.render(all);
   EXPECT_GE(r.end_frame(), 0.0);
 }
+
+TEST_F(RendererTest, MultiDrawGivesTheSamePixelsAsSingleDraws) {
+  Scene scene = test::box_scene({{{-3, -3, -11}, {3, 3, -10}},
+                                 {{-1, -1, -21}, {1, 1, -19}},
+                                 {{7, -1, -21}, {9, 1, -19}},
+                                 {{-9, -2, -30}, {-5, 2, -25}}});
+  const View view = make_view({{0, 0, 0}, 0, 0}, {60.0f, 0.1f, 100.0f}, kSize, kSize);
+  std::vector<std::uint32_t> images[2];
+  for (int multi = 0; multi < 2; ++multi) {
+    gl::RendererOptions o = small();
+    o.multi_draw = multi == 1;
+    gl::Renderer r(scene, o);
+    for (int frame = 0; frame < 2; ++frame) {  // the second frame reuses the indirect buffer
+      r.begin_frame(view);
+      const ObjectId all[] = {3, 0, 2, 1};
+      r.render(all);
+      r.end_frame();
+    }
+    images[multi] = r.read_ids();
+    EXPECT_EQ(r.stats().draw_calls, 8u);
+  }
+  EXPECT_EQ(images[0], images[1]);
+  EXPECT_EQ(ids_in(images[1]), (std::set<ObjectId>{0, 2, 3}));
+}

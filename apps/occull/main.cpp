@@ -128,7 +128,14 @@ struct BenchArgs {
   std::string size = "1280x720";
   std::vector<std::string> opts;
   std::string query_mode = "samples";
+  std::string draw = "single";
 };
+
+bool parse_draw_mode(const std::string& s) {
+  if (s == "single") return false;
+  if (s == "multi") return true;
+  throw occull::InputError(fmt::format("unknown draw mode '{}'; valid modes: single, multi", s));
+}
 
 occull::Options parse_options(const std::vector<std::string>& opts) {
   occull::Options options;
@@ -149,6 +156,7 @@ int cmd_bench(const BenchArgs& a) {
   c.height = size.height;
   c.options = parse_options(a.opts);
   c.query_mode = parse_query_mode(a.query_mode);
+  c.multi_draw = parse_draw_mode(a.draw);
   Progress progress;
   const auto result = occull::run_bench(c, std::ref(progress));
   occull::print_table(result, std::cout);
@@ -216,6 +224,9 @@ int main(int argc, char** argv) {
   b->add_option("--size", bench.size, "render size WIDTHxHEIGHT")->capture_default_str();
   b->add_option("--opt", bench.opts, "algorithm option algo.key=value (repeatable)");
   b->add_option("--query-mode", bench.query_mode, "occlusion query target: samples, any, conservative")
+      ->capture_default_str();
+  b->add_option("--draw", bench.draw,
+                "object submission: single (one draw per object) or multi (one multi-draw per material run)")
       ->capture_default_str();
 
   RenderArgs render;

@@ -77,6 +77,8 @@ struct AlgorithmInfo {
 [[nodiscard]] std::span<const AlgorithmInfo> algorithms();
 /// Comma-separated list of algorithm names (for error messages and help).
 [[nodiscard]] std::string algorithm_names();
+/// The named algorithm. Throws InputError listing the valid names.
+[[nodiscard]] const AlgorithmInfo& find_algorithm(std::string_view name);
 
 /// Checks every key of `options`: its algorithm must exist and know the
 /// option. Throws InputError listing the valid algorithms or options.

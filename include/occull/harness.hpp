@@ -64,6 +64,7 @@ struct BenchConfig {
   int height = 720;
   Options options;
   gl::QueryMode query_mode = gl::QueryMode::samples_passed;
+  bool multi_draw = false;                ///< see gl::RendererOptions::multi_draw
 };
 
 struct AlgorithmRun {

@@ -29,6 +29,7 @@ glm::mat4 Motion::transform_at(double time_s) const {
   const std::size_t n = waypoints.size();
   double loop = 0.0;
   for (std::size_t i = 0; i < n; ++i) loop += glm::length(waypoints[(i + 1) % n] - waypoints[i]);
+  if (loop <= 0.0) return glm::translate(glm::mat4(1.0f), waypoints.front());
   double s = std::fmod(start_offset + speed * time_s, loop);
   if (s < 0.0) s += loop;
   for (std::size_t i = 0; i < n; ++i) {

@@ -130,12 +130,17 @@ void check_options(const Options& options) {
   }
 }
 
+const AlgorithmInfo& find_algorithm(std::string_view name) {
+  for (const AlgorithmInfo& a : algorithms())
+    if (a.name == name) return a;
+  throw InputError(
+      fmt::format("unknown algorithm '{}'; valid algorithms: {}", name, algorithm_names()));
+}
+
 std::unique_ptr<Culler> make_culler(std::string_view name, const SceneIndex& index,
                                     const Options& options) {
+  (void)find_algorithm(name);
   const Entry* entry = find(name);
-  if (!entry)
-    throw InputError(
-        fmt::format("unknown algorithm '{}'; valid algorithms: {}", name, algorithm_names()));
   const std::string prefix = entry->info.name + ".";
   for (const auto& [key, value] : options.values())
     if (key.rfind(prefix, 0) == 0) check_option(*entry, key, key.substr(prefix.size()));

@@ -96,16 +96,14 @@ BenchResult run_bench(const BenchConfig& config, const ProgressFn& progress) {
   if (names.empty())
     for (const auto& a : algorithms()) names.push_back(a.name);
   // Validate names and options before the (slow) scene set-up.
-  {
-    const Scene empty;
-    const Bvh bvh = Bvh::build(empty);
-    for (const auto& n : names) (void)make_culler(n, {empty, bvh}, config.options);
-  }
+  for (const auto& n : names) (void)find_algorithm(n);
+  check_options(config.options);
   gl::RendererOptions ropts;
   ropts.width = config.width;
   ropts.height = config.height;
   ropts.query_mode = config.query_mode;
   ropts.write_ids = false;
+  ropts.multi_draw = config.multi_draw;
   Session session(config.scene, ropts);
   const CameraPath& path = config.path.empty() ? session.bundle().paths.front()
                                                : session.bundle().path(config.path);

@@ -35,21 +35,26 @@ void print_table(const BenchResult& r, std::ostream& out) {
     if (run.name == "vfc") vfc = &run;
   const double vfc_mean = vfc ? summarize(frame_times(*vfc)).mean : 0.0;
 
-  out << fmt::format("{:<10} {:>8} {:>8} {:>8} {:>8} {:>7} {:>8} {:>10} {:>8} {:>8}\n", "algorithm",
-                     "mean ms", "median", "p95", "max", "vs vfc", "draws", "triangles", "objects",
-                     "cpu ms");
+  out << fmt::format("{:<10} {:>8} {:>8} {:>8} {:>8} {:>7} {:>8} {:>10} {:>8} {:>8} {:>8}\n",
+                     "algorithm", "mean ms", "median", "p95", "max", "vs vfc", "draws", "triangles",
+                     "objects", "cpu ms", "gpu ms");
   for (const auto& run : r.runs) {
     const Summary s = summarize(frame_times(run));
     const std::string ratio = vfc_mean > 0 ? fmt::format("{:.2f}", s.mean / vfc_mean) : "-";
-    out << fmt::format("{:<10} {:>8.2f} {:>8.2f} {:>8.2f} {:>8.2f} {:>7} {:>8.0f} {:>10.0f} {:>8.0f} {:>8.3f}\n",
+    out << fmt::format("{:<10} {:>8.2f} {:>8.2f} {:>8.2f} {:>8.2f} {:>7} {:>8.0f} {:>10.0f} {:>8.0f} {:>8.3f} {:>8.2f}\n",
                        run.name, s.mean, s.median, s.p95, s.max, ratio,
                        mean_of(run, [](const FrameStats& f) { return f.draw_calls; }),
                        mean_of(run, [](const FrameStats& f) { return f.triangles; }),
                        mean_of(run, [](const FrameStats& f) { return f.objects_rendered; }),
-                       mean_of(run, [](const FrameStats& f) { return f.cpu_ms; }));
+                       mean_of(run, [](const FrameStats& f) { return f.cpu_ms; }),
+                       mean_of(run, [](const FrameStats& f) { return f.gpu_ms; }));
   }
-  out << "\nper frame: draws, triangles, objects = means; vs vfc = mean frame time / vfc's mean "
-         "frame time in this run.\n";
+  out << "\nper frame (means): draws, triangles, objects; cpu ms = the culler's own CPU time; "
+         "gpu ms = timer query over the frame.\nvs vfc = mean frame time / vfc's mean frame time "
+         "in this run.\n";
+  if (r.device.renderer.find("llvmpipe") != std::string::npos)
+    out << "note: llvmpipe's GL_TIME_ELAPSED leaves out most of its (deferred, multi-threaded) "
+           "rasterization; judge by wall-clock frame times.\n";
 }
 
 }  // namespace occull

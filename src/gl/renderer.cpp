@@ -122,6 +122,13 @@ GLenum query_target(QueryMode mode) {
   return GL_SAMPLES_PASSED;
 }
 
+// Layout of glMultiDrawElementsIndirect's commands.
+struct DrawCommand {
+  GLuint count, instance_count, first_index;
+  GLint base_vertex;
+  GLuint base_instance;
+};
+
 constexpr GLsizeiptr kBoxCapacity = 1 << 16;  // boxes per stream-buffer fill
 
 }  // namespace
@@ -154,6 +161,9 @@ struct Renderer::Impl {
   glm::vec3 eye{0.0f};
   std::vector<ObjectId> opaque;
   std::vector<ObjectId> translucent;  // deferred to end_frame
+  GLuint indirect_buffer = 0;         // multi-draw commands, refilled every frame
+  GLsizeiptr indirect_capacity = 0, indirect_offset = 0;
+  std::vector<DrawCommand> commands;
 
   Impl(const Scene& s, const RendererOptions& o) : scene(s), options(o) {}
 
@@ -164,6 +174,7 @@ struct Renderer::Impl {
   void enter_render_state(BackendStats& stats);
   void enter_query_state(BackendStats& stats);
   void draw_objects(std::span<const ObjectId> ids, BackendStats& stats);
+  void multi_draw(std::span<const ObjectId> ids);
   void upload_dynamic_transforms();
 };
 
@@ -286,6 +297,7 @@ void Renderer::Impl::create_query_resources() {
   glNamedBufferStorage(cube_vertices, sizeof(corners), corners, 0);
   glCreateBuffers(1, &cube_indices);
   glNamedBufferStorage(cube_indices, sizeof(idx), idx, 0);
+  glCreateBuffers(1, &indirect_buffer);
   glCreateBuffers(1, &box_buffer);
   glNamedBufferData(box_buffer, kBoxCapacity * GLsizeiptr(sizeof(Aabb)), nullptr, GL_STREAM_DRAW);
   static_assert(sizeof(Aabb) == 6 * sizeof(float), "Aabb is uploaded as two vec3");
@@ -345,22 +357,54 @@ void Renderer::Impl::enter_query_state(BackendStats& stats) {
 
 void Renderer::Impl::draw_objects(std::span<const ObjectId> ids, BackendStats& stats) {
   enter_render_state(stats);
-  for (ObjectId id : ids) {
-    const Object& o = scene.object(id);
-    if (o.material != bound_material) {
-      glUniform1ui(u_material, o.material);
-      bound_material = o.material;
+  for (std::size_t begin = 0; begin < ids.size();) {
+    // One run of objects with the same material: one material bind, then
+    // either one multi-draw or one draw per object.
+    const MaterialId material = scene.object(ids[begin]).material;
+    std::size_t end = begin + 1;
+    while (end < ids.size() && scene.object(ids[end]).material == material) ++end;
+    if (material != bound_material) {
+      glUniform1ui(u_material, material);
+      bound_material = material;
       ++stats.material_changes;
     }
-    const MeshRange& r = meshes[o.mesh];
-    glDrawElementsInstancedBaseVertexBaseInstance(
-        GL_TRIANGLES, r.index_count, GL_UNSIGNED_INT,
-        reinterpret_cast<const void*>(r.first_index * sizeof(std::uint32_t)), 1, r.base_vertex,
-        id);
-    ++stats.draw_calls;
-    ++stats.objects_rendered;
-    stats.triangles += o.triangles;
+    const auto run = ids.subspan(begin, end - begin);
+    if (options.multi_draw) {
+      multi_draw(run);
+    } else {
+      for (ObjectId id : run) {
+        const MeshRange& r = meshes[scene.object(id).mesh];
+        glDrawElementsInstancedBaseVertexBaseInstance(
+            GL_TRIANGLES, r.index_count, GL_UNSIGNED_INT,
+            reinterpret_cast<const void*>(r.first_index * sizeof(std::uint32_t)), 1,
+            r.base_vertex, id);
+      }
+    }
+    for (ObjectId id : run) stats.triangles += scene.object(id).triangles;
+    stats.draw_calls += run.size();
+    stats.objects_rendered += run.size();
+    begin = end;
   }
+}
+
+void Renderer::Impl::multi_draw(std::span<const ObjectId> ids) {
+  commands.clear();
+  for (ObjectId id : ids) {
+    const MeshRange& r = meshes[scene.object(id).mesh];
+    commands.push_back({GLuint(r.index_count), 1, GLuint(r.first_index), r.base_vertex, id});
+  }
+  const auto bytes = GLsizeiptr(commands.size() * sizeof(DrawCommand));
+  if (indirect_offset + bytes > indirect_capacity) {
+    indirect_capacity = std::max(indirect_capacity, 2 * bytes);
+    glNamedBufferData(indirect_buffer, indirect_capacity, nullptr, GL_STREAM_DRAW);
+    indirect_offset = 0;
+  }
+  glNamedBufferSubData(indirect_buffer, indirect_offset, bytes, commands.data());
+  glBindBuffer(GL_DRAW_INDIRECT_BUFFER, indirect_buffer);
+  glMultiDrawElementsIndirect(GL_TRIANGLES, GL_UNSIGNED_INT,
+                              reinterpret_cast<const void*>(indirect_offset), GLsizei(commands.size()),
+                              0);
+  indirect_offset += bytes;
 }
 
 void Renderer::Impl::upload_dynamic_transforms() {
@@ -393,7 +437,7 @@ Renderer::~Renderer() {
   if (g.timer) glDeleteQueries(1, &g.timer);
   const GLuint buffers[] = {g.vertex_buffer, g.index_buffer, g.object_index_buffer,
                             g.object_buffer, g.material_buffer, g.cube_vertices,
-                            g.cube_indices,  g.box_buffer};
+                            g.cube_indices,  g.box_buffer,          g.indirect_buffer};
   glDeleteBuffers(GLsizei(std::size(buffers)), buffers);
   const GLuint vaos[] = {g.scene_vao, g.query_vao};
   glDeleteVertexArrays(2, vaos);
@@ -436,6 +480,9 @@ void Renderer::begin_frame(const View& view) {
   // frame's draws keep their copy).
   glNamedBufferData(g.box_buffer, kBoxCapacity * GLsizeiptr(sizeof(Aabb)), nullptr, GL_STREAM_DRAW);
   g.box_offset = 0;
+  if (g.indirect_capacity > 0)
+    glNamedBufferData(g.indirect_buffer, g.indirect_capacity, nullptr, GL_STREAM_DRAW);
+  g.indirect_offset = 0;
   if (g.timer_supported) glBeginQuery(GL_TIME_ELAPSED, g.timer);
 }
 

@@ -25,6 +25,9 @@ struct RendererOptions {
   QueryMode query_mode = QueryMode::samples_passed;
   bool write_ids = true;       ///< also write object ids (id + 1) into the R32UI target
   bool cull_backfaces = true;  ///< for scene geometry (query boxes are never back-face culled)
+  /// Submit each material run of a render() call as one glMultiDrawElementsIndirect
+  /// instead of one draw per object (same pixels; less driver overhead per object).
+  bool multi_draw = false;
   glm::vec3 background{0.62f, 0.74f, 0.86f};
 };
 
