@@ -10,7 +10,7 @@ packages=(
   # headless OpenGL 4.5: EGL + GLVND + Mesa (llvmpipe works without a GPU)
   libegl-dev libopengl-dev libgl1-mesa-dri libegl1
   # libraries
-  libglm-dev libfmt-dev libcli11-dev nlohmann-json3-dev libstb-dev
+  libglm-dev libfmt-dev libcli11-dev nlohmann-json3-dev libstb-dev libtinyxml2-dev
   # tests and benchmarks
   libgtest-dev libgmock-dev libbenchmark-dev
 )

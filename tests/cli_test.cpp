@@ -50,13 +50,13 @@ TEST(Cli, UnknownSceneListsValidScenes) {
 }
 
 TEST(Cli, UnknownPathListsValidPaths) {
-  const CliRun r = run(std::string("bench ") + kTinyCity + " --path nowhere --frames 1 --algo vfc");
+  const CliRun r = run(std::string("bench ") + kTinyCity + " --path nowhere --frames 1 --algo vfc --no-report");
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.output.find("street, flyover, turn"), std::string::npos) << r.output;
 }
 
 TEST(Cli, UnknownAlgorithmListsValidAlgorithms) {
-  const CliRun r = run(std::string("bench ") + kTinyCity + " --algo vfc,magic --frames 1");
+  const CliRun r = run(std::string("bench ") + kTinyCity + " --algo vfc,magic --frames 1 --no-report");
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.output.find("none, vfc"), std::string::npos) << r.output;
 }
@@ -76,7 +76,7 @@ TEST(Cli, InvalidFrameCountIsRejected) {
 }
 
 TEST(Cli, UnknownOptionListsValidOptions) {
-  const CliRun r = run(std::string("bench ") + kTinyCity + " --algo vfc --frames 1 --opt vfc.speed=3");
+  const CliRun r = run(std::string("bench ") + kTinyCity + " --algo vfc --frames 1 --opt vfc.speed=3 --no-report");
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.output.find("valid options"), std::string::npos) << r.output;
 }
@@ -96,11 +96,12 @@ TEST(Cli, ScenesListsParametersPathsAndCounts) {
 }
 
 TEST(Cli, BenchPrintsATableRowPerAlgorithm) {
-  const CliRun r = run(std::string("bench ") + kTinyCity + " --algo none,vfc --frames 3 --warmup 1");
+  const CliRun r = run(std::string("bench ") + kTinyCity + " --algo none,vfc,oracle --frames 3 --warmup 1 --no-report");
   ASSERT_EQ(r.code, 0) << r.output;
-  EXPECT_NE(r.output.find("\nnone "), std::string::npos) << r.output;
-  EXPECT_NE(r.output.find("\nvfc "), std::string::npos) << r.output;
-  EXPECT_NE(r.output.find("median"), std::string::npos);
+  for (const char* row : {"\nnone ", "\nvfc ", "\noracle "})
+    EXPECT_NE(r.output.find(row), std::string::npos) << row << r.output;
+  for (const char* col : {"median", "vs vfc", "vs orcl", "missed", "wrong px"})
+    EXPECT_NE(r.output.find(col), std::string::npos) << col;
 }
 
 TEST(Cli, RenderWritesAPng) {
@@ -126,4 +127,38 @@ TEST(Cli, DriverWithoutOpenGL45ExitsThree) {
   const CliRun r = run("info", "MESA_GL_VERSION_OVERRIDE=3.3");
   EXPECT_EQ(r.code, 3) << r.output;
   EXPECT_NE(r.output.find("4.5"), std::string::npos) << r.output;
+}
+
+TEST(Cli, BenchWritesJsonCsvAndTheReportFolder) {
+  const std::string dir = ::testing::TempDir() + "occull_cli_report";
+  const std::string json = ::testing::TempDir() + "occull_cli.json";
+  const std::string csv = ::testing::TempDir() + "occull_cli.csv";
+  std::remove(json.c_str());
+  std::remove(csv.c_str());
+  const CliRun r = run(std::string("bench ") + kTinyCity + " --algo vfc,oracle --frames 3 --warmup 0 --repeat 2 --json " +
+                       json + " --csv " + csv + " --report " + dir);
+  ASSERT_EQ(r.code, 0) << r.output;
+  for (const std::string& f : {json, csv, dir + "/report.md", dir + "/frame_ms.svg", dir + "/queries.svg",
+                               dir + "/triangles.svg"})
+    EXPECT_TRUE(std::ifstream(f).good()) << f;
+  std::ifstream in(json);
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  EXPECT_NE(text.find("\"repeat\": 2"), std::string::npos) << text.substr(0, 400);
+}
+
+TEST(Cli, OracleWithoutVerificationIsAUsageError) {
+  const CliRun r = run(std::string("bench ") + kTinyCity + " --algo oracle --frames 2 --verify off --no-report");
+  EXPECT_EQ(r.code, 2) << r.output;
+  EXPECT_NE(r.output.find("ground truth"), std::string::npos) << r.output;
+}
+
+TEST(Cli, InvalidRepeatAndVerifyValuesAreRejected) {
+  EXPECT_EQ(run(std::string("bench ") + kTinyCity + " --repeat 0 --no-report").code, 2);
+  EXPECT_EQ(run(std::string("bench ") + kTinyCity + " --verify maybe --no-report").code, 2);
+}
+
+TEST(Cli, UnwritableReportFolderIsAClearError) {
+  const CliRun r = run(std::string("bench ") + kTinyCity + " --algo vfc --frames 1 --warmup 0 --report /proc/occull-report");
+  EXPECT_EQ(r.code, 2) << r.output;
+  EXPECT_NE(r.output.find("/proc/occull-report"), std::string::npos) << r.output;
 }

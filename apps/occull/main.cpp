@@ -8,6 +8,7 @@
 #include "occull/error.hpp"
 #include "occull/gl/context.hpp"
 #include "occull/harness.hpp"
+#include "occull/report.hpp"
 #include "occull/scenes.hpp"
 
 #include <CLI/CLI.hpp>
@@ -16,7 +17,9 @@
 
 #include <chrono>
 #include <cstdio>
+#include <fstream>
 #include <iostream>
+#include <memory>
 #include <unistd.h>
 
 namespace {
@@ -129,7 +132,19 @@ struct BenchArgs {
   std::vector<std::string> opts;
   std::string query_mode = "samples";
   std::string draw = "single";
+  int repeat = 1;
+  std::string verify = "on";
+  std::string json;
+  std::string csv;
+  std::string report = "occull-report";
+  bool no_report = false;
 };
+
+bool parse_on_off(const std::string& flag, const std::string& s) {
+  if (s == "on" || s == "true" || s == "yes" || s == "1") return true;
+  if (s == "off" || s == "false" || s == "no" || s == "0") return false;
+  throw occull::InputError(fmt::format("{} '{}': expected on or off", flag, s));
+}
 
 bool parse_draw_mode(const std::string& s) {
   if (s == "single") return false;
@@ -142,6 +157,18 @@ occull::Options parse_options(const std::vector<std::string>& opts) {
   for (const auto& o : opts) options.set(o);
   occull::check_options(options);
   return options;
+}
+
+// Opens an output file before the (long) run, so a bad path fails at once.
+std::unique_ptr<std::ofstream> open_output(const std::string& path) {
+  if (path.empty()) return nullptr;
+  auto f = std::make_unique<std::ofstream>(path, std::ios::binary);
+  if (!*f) throw occull::InputError(fmt::format("cannot open '{}' for writing", path));
+  return f;
+}
+
+void check_written(const std::ofstream& f, const std::string& path) {
+  if (!f) throw occull::InputError(fmt::format("cannot write '{}'", path));
 }
 
 int cmd_bench(const BenchArgs& a) {
@@ -157,9 +184,30 @@ int cmd_bench(const BenchArgs& a) {
   c.options = parse_options(a.opts);
   c.query_mode = parse_query_mode(a.query_mode);
   c.multi_draw = parse_draw_mode(a.draw);
+  c.repeat = a.repeat;
+  c.verify = parse_on_off("--verify", a.verify);
+  const bool report = !a.no_report && !a.report.empty();
+  const auto json = open_output(a.json);
+  const auto csv = open_output(a.csv);
+  if (report) occull::prepare_report_folder(a.report);
   Progress progress;
   const auto result = occull::run_bench(c, std::ref(progress));
   occull::print_table(result, std::cout);
+  std::cout.flush();
+  if (json) {
+    occull::write_json(result, *json);
+    json->flush();
+    check_written(*json, a.json);
+  }
+  if (csv) {
+    occull::write_csv(result, *csv);
+    csv->flush();
+    check_written(*csv, a.csv);
+  }
+  if (report) {
+    const auto files = occull::write_report(result, a.report);
+    std::fprintf(stderr, "report: %s/report.md (%zu files)\n", a.report.c_str(), files.size());
+  }
   return 0;
 }
 
@@ -225,6 +273,15 @@ int main(int argc, char** argv) {
   b->add_option("--opt", bench.opts, "algorithm option algo.key=value (repeatable)");
   b->add_option("--query-mode", bench.query_mode, "occlusion query target: samples, any, conservative")
       ->capture_default_str();
+  b->add_option("--repeat", bench.repeat, "run the whole set R times, interleaved; report medians")
+      ->capture_default_str();
+  b->add_option("--verify", bench.verify, "check every frame against ground truth (on/off)")
+      ->capture_default_str();
+  b->add_option("--json", bench.json, "write the results as JSON to this file");
+  b->add_option("--csv", bench.csv, "write one CSV row per algorithm, repeat and frame to this file");
+  b->add_option("--report", bench.report, "write report.md, SVG charts, JSON and CSV into this folder")
+      ->capture_default_str();
+  b->add_flag("--no-report", bench.no_report, "do not write the report folder");
   b->add_option("--draw", bench.draw,
                 "object submission: single (one draw per object) or multi (one multi-draw per material run)")
       ->capture_default_str();

@@ -71,6 +71,9 @@ struct AlgorithmInfo {
   std::string summary;
   bool conservative = true;   ///< never culls a visible object (verified by the harness)
   std::vector<OptionInfo> options;
+  /// Needs each frame's ground truth, so only the harness can run it
+  /// (`oracle`); make_culler() refuses it.
+  bool harness_only = false;
 };
 
 /// Every algorithm make_culler() knows, in presentation order.

@@ -1,5 +1,20 @@
 // occull — the measuring harness: flies a camera path through a scene with
-// each culler on the reference renderer and records what every frame cost.
+// each culler on the reference renderer, records what every frame cost and
+// checks every frame against ground truth.
+//
+// Ground truth: an untimed pass per frame renders every object inside the
+// view frustum into the object-id buffer; the truth set is every object with
+// at least one pixel (translucent objects: at least one sample passing the
+// depth test). It depends only on the frame, so it is computed once per
+// frame and shared by every algorithm and repeat.
+//
+// Verification compares what an algorithm rendered in a timed frame with
+// that truth, outside the timed region. An object in the truth set that the
+// algorithm did not render is *missed*. Because the algorithm draws a subset
+// of the objects with the same depth test, every object it did render owns
+// exactly its truth pixels in its own image, so the pixels its image gets
+// wrong are exactly the truth pixels of the missed objects (`wrong_pixels`).
+// Timed frames are identical with and without verification.
 #pragma once
 
 #include "occull/bvh.hpp"
@@ -18,19 +33,58 @@
 
 namespace occull {
 
+/// Ground truth of one frame: visible objects sorted by id, with their pixels.
+using FrameTruth = std::vector<gl::Renderer::ObjectPixels>;
+
+/// Called as work progresses: a label (algorithm name, or "ground truth"),
+/// the step just done (0-based), the number of steps, and whether it was a
+/// warm-up step.
+using ProgressFn = std::function<void(std::string_view label, int step, int steps, bool warmup)>;
+
+/// Verification of one frame: fills truth_objects, missed_objects,
+/// wrong_pixels and extra_objects of `stats` from the frame's truth and the
+/// objects the algorithm rendered (duplicates allowed), and returns the
+/// missed ids (ascending). `object_count` is the scene's object count.
+std::vector<ObjectId> check_frame(std::span<const gl::Renderer::ObjectPixels> truth,
+                                  std::span<const ObjectId> rendered, std::size_t object_count,
+                                  FrameStats& stats);
+
+/// Frames of one algorithm over a path (one repeat).
+struct AlgorithmRun {
+  std::string name;
+  int repeat = 0;
+  std::vector<FrameStats> frames;
+  std::uint32_t longest_miss_frames = 0;  ///< longest run of frames one object stayed missed
+};
+
 /// A scene set up on the GL device: the context, the generated scene with
 /// its paths, its BVH and the renderer. Everything a run of frames needs.
 class Session {
  public:
-  /// Creates the GL context (throws GlUnavailable), builds the scene from
-  /// `scene_spec` (throws InputError) and its BVH, and the renderer.
+  /// Builds the scene from `scene_spec` (throws InputError) and its BVH,
+  /// then creates the GL context (throws GlUnavailable) and the renderer.
   Session(std::string_view scene_spec, const gl::RendererOptions& renderer_options);
   ~Session();
+  Session(const Session&) = delete;
+  Session& operator=(const Session&) = delete;
 
   /// Runs one frame: moves dynamic objects to `time_s` (untimed), then
   /// times refit, begin_frame, the culler and end_frame (closed by
   /// glFinish). Fills every timing and backend counter of the result.
   FrameStats run_frame(Culler& culler, const View& view, double time_s);
+
+  /// The ground truth of frames 0..frames-1 of `path` (untimed).
+  [[nodiscard]] std::vector<FrameTruth> ground_truth(const CameraPath& path, int frames,
+                                                     const ProgressFn& progress = {});
+
+  /// Makes a culler by name for this scene; `oracle` too (it is fed the
+  /// truth by run_path). Throws InputError like make_culler().
+  [[nodiscard]] std::unique_ptr<Culler> make(std::string_view name, const Options& options) const;
+
+  /// Runs `culler` over frames 0..frames-1 of `path`. With `truth` (one
+  /// entry per frame), verifies every frame; the oracle needs it.
+  AlgorithmRun run_path(std::string_view name, Culler& culler, const CameraPath& path, int frames,
+                        const std::vector<FrameTruth>* truth, const ProgressFn& progress = {});
 
   /// View of `path` at frame k of `frames`.
   [[nodiscard]] View view_at(const CameraPath& path, int k, int frames) const;
@@ -47,44 +101,26 @@ class Session {
   // Declared (so initialised) before bundle_, which records into it.
   double scene_build_ms_ = 0.0;
   double bvh_build_ms_ = 0.0;
-  std::unique_ptr<gl::Context> context_;
-  gl::DeviceInfo device_;
   SceneBundle bundle_;
   Bvh bvh_;
+  std::unique_ptr<gl::Context> context_;
+  gl::DeviceInfo device_;
   std::unique_ptr<gl::Renderer> renderer_;
 };
 
 struct BenchConfig {
   std::string scene = "city";             ///< scene spec, see make_scene()
   std::string path;                       ///< camera path; empty = the scene's first
-  std::vector<std::string> algorithms;    ///< empty = every algorithm
-  int frames = 100;                       ///< timed frames per algorithm, >= 1
-  int warmup = 8;                         ///< untimed frames per algorithm first, >= 0
+  std::vector<std::string> algorithms;    ///< empty = every algorithm (oracle included)
+  int frames = 100;                       ///< timed frames per algorithm and repeat, >= 1
+  int warmup = 8;                         ///< untimed frames per algorithm and repeat first, >= 0
+  int repeat = 1;                         ///< runs of the whole set, interleaved (A B C A B C), >= 1
+  bool verify = true;                     ///< check every frame against ground truth
   int width = 1280;                       ///< pixels
   int height = 720;
   Options options;
   gl::QueryMode query_mode = gl::QueryMode::samples_passed;
   bool multi_draw = false;                ///< see gl::RendererOptions::multi_draw
-};
-
-struct AlgorithmRun {
-  std::string name;
-  std::vector<FrameStats> frames;
-};
-
-struct BenchResult {
-  gl::DeviceInfo device;
-  std::string scene;
-  std::string path;
-  std::size_t objects = 0;
-  std::uint64_t triangles = 0;
-  std::size_t bvh_nodes = 0;
-  double scene_build_ms = 0.0;
-  double bvh_build_ms = 0.0;
-  int frames = 0;
-  int width = 0;
-  int height = 0;
-  std::vector<AlgorithmRun> runs;
 };
 
 /// Mean, median, 95th percentile and maximum of a sample (all 0 when empty).
@@ -93,19 +129,64 @@ struct Summary {
 };
 [[nodiscard]] Summary summarize(std::vector<double> values);
 
-/// Called after each frame: algorithm, frame index (0-based), frame count,
-/// and whether the frame was a warm-up frame.
-using ProgressFn = std::function<void(std::string_view algorithm, int frame, int frames, bool warmup)>;
+/// One algorithm over all repeats. Timings and per-frame means are the
+/// median over repeats of each repeat's figure (ratios are taken within a
+/// repeat first, so drift of a shared machine cancels); correctness figures
+/// are the worst repeat's.
+struct AlgorithmSummary {
+  std::string name;
+  Summary frame_ms;
+  double ratio_to_vfc = 0.0;     ///< mean frame time / vfc's in the same repeat; 0 if vfc did not run
+  double ratio_to_oracle = 0.0;  ///< same against the oracle
+  double queries_per_frame = 0.0;
+  double multiqueries_per_frame = 0.0;
+  double failed_multiqueries_per_frame = 0.0;
+  double query_batches_per_frame = 0.0;
+  double state_changes_per_frame = 0.0;
+  double render_flushes_per_frame = 0.0;
+  double draw_calls_per_frame = 0.0;
+  double triangles_per_frame = 0.0;
+  double objects_rendered_per_frame = 0.0;
+  double nodes_visited_per_frame = 0.0;
+  double extra_objects_per_frame = 0.0;  ///< over-rendering (verified runs)
+  double wait_ms_per_frame = 0.0;
+  double cpu_ms_per_frame = 0.0;
+  double gpu_ms_per_frame = 0.0;
+  std::uint64_t missed_objects = 0;       ///< sum over frames of objects missed
+  std::uint64_t frames_with_misses = 0;
+  std::uint64_t wrong_pixels = 0;         ///< sum over frames
+  std::uint64_t worst_frame_wrong_pixels = 0;
+  std::uint32_t longest_miss_frames = 0;
+};
 
-/// Runs every algorithm over the same path, one after another: `warmup`
-/// frames spread over the path with a throw-away culler, then `frames`
-/// timed frames with a fresh one. Throws InputError for unknown names or
-/// options, GlUnavailable without a usable OpenGL.
+struct BenchResult {
+  gl::DeviceInfo device;
+  std::string commit;  ///< occull's git commit at build time
+  std::string scene;
+  std::string path;
+  std::size_t objects = 0;
+  std::uint64_t triangles = 0;
+  std::size_t bvh_nodes = 0;
+  double scene_build_ms = 0.0;
+  double bvh_build_ms = 0.0;
+  int frames = 0;
+  int warmup = 0;
+  int repeat = 1;
+  bool verified = false;
+  int width = 0;
+  int height = 0;
+  std::vector<AlgorithmRun> runs;            ///< in execution order
+  std::vector<AlgorithmSummary> summaries;   ///< one per algorithm, in the order asked
+};
+
+/// Summaries of `runs` (see AlgorithmSummary), one per algorithm name in
+/// first-appearance order.
+[[nodiscard]] std::vector<AlgorithmSummary> summarize_runs(std::span<const AlgorithmRun> runs);
+
+/// Runs every algorithm over the same path, `repeat` times interleaved:
+/// per algorithm `warmup` frames spread over the path with a throw-away
+/// culler, then `frames` timed frames with a fresh one. Throws InputError
+/// for unknown names or options, GlUnavailable without a usable OpenGL.
 [[nodiscard]] BenchResult run_bench(const BenchConfig& config, const ProgressFn& progress = {});
-
-/// The per-algorithm table: frame ms mean / median / p95 / max, ratio to
-/// vfc (when it ran), draw calls, triangles and objects rendered per frame,
-/// culler CPU ms per frame.
-void print_table(const BenchResult& result, std::ostream& out);
 
 }  // namespace occull

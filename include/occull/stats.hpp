@@ -30,6 +30,12 @@ struct FrameStats {
   std::uint64_t draw_calls = 0;
   std::uint64_t triangles = 0;
   std::uint64_t objects_rendered = 0;
+
+  // Verification against the frame's ground truth (all 0 when not verified).
+  std::uint32_t truth_objects = 0;   ///< objects with a visible pixel in the ground truth
+  std::uint32_t missed_objects = 0;  ///< in the truth, not rendered: a visible object culled
+  std::uint64_t wrong_pixels = 0;    ///< pixels the missed objects own in the truth image
+  std::uint32_t extra_objects = 0;   ///< rendered, not in the truth: culling inefficiency
 };
 
 }  // namespace occull

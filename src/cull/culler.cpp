@@ -25,6 +25,10 @@ const std::vector<Entry>& registry() {
        &detail::make_none},
       {{"vfc", "hierarchical view-frustum culling over the BVH, front to back", true, {}},
        &detail::make_vfc},
+      {{"oracle",
+        "renders exactly the ground-truth visible set, no queries: the lower bound (occull bench only)",
+        true, {}, true},
+       nullptr},
   };
   return entries;
 }
@@ -144,6 +148,10 @@ std::unique_ptr<Culler> make_culler(std::string_view name, const SceneIndex& ind
   const std::string prefix = entry->info.name + ".";
   for (const auto& [key, value] : options.values())
     if (key.rfind(prefix, 0) == 0) check_option(*entry, key, key.substr(prefix.size()));
+  if (!entry->make)
+    throw InputError(fmt::format("{} needs each frame's ground truth: it runs only in the harness "
+                                 "(occull bench)",
+                                 entry->info.name));
   return entry->make(index, options);
 }
 

@@ -1,13 +1,19 @@
 #include "occull/harness.hpp"
 
 #include "occull/error.hpp"
+#include "oracle.hpp"
 
 #include <fmt/format.h>
 
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <map>
 #include <numeric>
+
+#ifndef OCCULL_COMMIT
+#define OCCULL_COMMIT "unknown"
+#endif
 
 namespace occull {
 namespace {
@@ -25,7 +31,33 @@ SceneBundle timed_make_scene(std::string_view spec, double& ms) {
   return b;
 }
 
+double median_of(std::vector<double> v) { return summarize(std::move(v)).median; }
+
 }  // namespace
+
+std::vector<ObjectId> check_frame(std::span<const gl::Renderer::ObjectPixels> truth,
+                                  std::span<const ObjectId> rendered, std::size_t object_count,
+                                  FrameStats& stats) {
+  std::vector<std::uint8_t> drawn(object_count, 0);
+  for (ObjectId id : rendered) drawn[id] = 1;
+  std::vector<ObjectId> missed;
+  stats.truth_objects = std::uint32_t(truth.size());
+  stats.missed_objects = 0;
+  stats.wrong_pixels = 0;
+  std::size_t rendered_and_visible = 0;
+  for (const auto& t : truth) {
+    if (drawn[t.id]) {
+      ++rendered_and_visible;
+    } else {
+      missed.push_back(t.id);
+      stats.wrong_pixels += t.pixels;
+    }
+  }
+  stats.missed_objects = std::uint32_t(missed.size());
+  const auto distinct = std::size_t(std::count(drawn.begin(), drawn.end(), std::uint8_t(1)));
+  stats.extra_objects = std::uint32_t(distinct - rendered_and_visible);
+  return missed;
+}
 
 // The scene first: a bad spec is reported before any GL work.
 Session::Session(std::string_view scene_spec, const gl::RendererOptions& renderer_options)
@@ -75,6 +107,62 @@ FrameStats Session::run_frame(Culler& culler, const View& view, double time_s) {
   return s;
 }
 
+std::vector<FrameTruth> Session::ground_truth(const CameraPath& path, int frames,
+                                              const ProgressFn& progress) {
+  std::vector<FrameTruth> truth;
+  truth.reserve(std::size_t(frames));
+  std::vector<ObjectId> in_frustum;
+  for (int k = 0; k < frames; ++k) {
+    bundle_.scene.update(path.frame_time(k, frames));
+    const View view = view_at(path, k, frames);
+    in_frustum.clear();
+    const auto objects = bundle_.scene.objects();
+    for (ObjectId id = 0; id < objects.size(); ++id)
+      if (view.frustum.classify(objects[id].bounds) != Containment::outside) in_frustum.push_back(id);
+    truth.push_back(renderer_->visible_pixels(view, in_frustum));
+    if (progress) progress("ground truth", k, frames, false);
+  }
+  return truth;
+}
+
+std::unique_ptr<Culler> Session::make(std::string_view name, const Options& options) const {
+  if (find_algorithm(name).name == "oracle") return std::make_unique<detail::OracleCuller>(bundle_.scene);
+  return make_culler(name, index(), options);
+}
+
+AlgorithmRun Session::run_path(std::string_view name, Culler& culler, const CameraPath& path,
+                               int frames, const std::vector<FrameTruth>* truth,
+                               const ProgressFn& progress) {
+  auto* oracle = dynamic_cast<detail::OracleCuller*>(&culler);
+  if (oracle && !truth) throw InputError("the oracle needs ground truth: run it with verification on");
+  AlgorithmRun run{std::string(name), 0, {}, 0};
+  run.frames.reserve(std::size_t(frames));
+  std::vector<std::uint32_t> miss_run(bundle_.scene.objects().size(), 0);
+  std::vector<ObjectId> previously_missed;
+  for (int k = 0; k < frames; ++k) {
+    if (oracle) {
+      std::vector<ObjectId> visible;
+      visible.reserve((*truth)[std::size_t(k)].size());
+      for (const auto& t : (*truth)[std::size_t(k)]) visible.push_back(t.id);
+      oracle->set_visible(std::move(visible));
+    }
+    FrameStats s = run_frame(culler, view_at(path, k, frames), path.frame_time(k, frames));
+    if (truth) {
+      // Outside the timed region: compare what was rendered with the truth.
+      const std::vector<ObjectId> missed =
+          check_frame((*truth)[std::size_t(k)], renderer_->frame_objects(),
+                      bundle_.scene.objects().size(), s);
+      for (ObjectId id : previously_missed)
+        if (!std::binary_search(missed.begin(), missed.end(), id)) miss_run[id] = 0;
+      for (ObjectId id : missed) run.longest_miss_frames = std::max(run.longest_miss_frames, ++miss_run[id]);
+      previously_missed = missed;
+    }
+    run.frames.push_back(s);
+    if (progress) progress(name, k, frames, false);
+  }
+  return run;
+}
+
 Summary summarize(std::vector<double> v) {
   Summary s;
   if (v.empty()) return s;
@@ -89,27 +177,122 @@ Summary summarize(std::vector<double> v) {
   return s;
 }
 
+std::vector<AlgorithmSummary> summarize_runs(std::span<const AlgorithmRun> runs) {
+  // Per repeat: the mean frame time of each algorithm, for ratios within it.
+  std::map<std::pair<int, std::string>, double> mean_ms;
+  std::vector<std::string> names;
+  for (const AlgorithmRun& r : runs) {
+    std::vector<double> ms;
+    for (const FrameStats& f : r.frames) ms.push_back(f.frame_ms);
+    mean_ms[{r.repeat, r.name}] = summarize(ms).mean;
+    if (std::find(names.begin(), names.end(), r.name) == names.end()) names.push_back(r.name);
+  }
+
+  std::vector<AlgorithmSummary> out;
+  for (const std::string& name : names) {
+    AlgorithmSummary a;
+    a.name = name;
+    // Figures per repeat, then medians across repeats.
+    std::map<std::string, std::vector<double>> per_repeat;
+    for (const AlgorithmRun& r : runs) {
+      if (r.name != name) continue;
+      const double n = std::max<double>(1.0, double(r.frames.size()));
+      std::vector<double> ms;
+      std::map<std::string, double> sums;
+      std::uint64_t missed = 0, frames_missing = 0, wrong = 0, worst = 0;
+      for (const FrameStats& f : r.frames) {
+        ms.push_back(f.frame_ms);
+        sums["queries"] += double(f.queries);
+        sums["multiqueries"] += double(f.multiqueries);
+        sums["failed_multiqueries"] += double(f.failed_multiqueries);
+        sums["query_batches"] += double(f.query_batches);
+        sums["state_changes"] += double(f.state_changes);
+        sums["render_flushes"] += double(f.render_flushes);
+        sums["draw_calls"] += double(f.draw_calls);
+        sums["triangles"] += double(f.triangles);
+        sums["objects_rendered"] += double(f.objects_rendered);
+        sums["nodes_visited"] += double(f.nodes_visited);
+        sums["extra_objects"] += double(f.extra_objects);
+        sums["wait_ms"] += f.wait_ms;
+        sums["cpu_ms"] += f.cpu_ms;
+        sums["gpu_ms"] += f.gpu_ms;
+        missed += f.missed_objects;
+        frames_missing += f.missed_objects > 0 ? 1 : 0;
+        wrong += f.wrong_pixels;
+        worst = std::max(worst, f.wrong_pixels);
+      }
+      const Summary s = summarize(ms);
+      per_repeat["mean"].push_back(s.mean);
+      per_repeat["median"].push_back(s.median);
+      per_repeat["p95"].push_back(s.p95);
+      per_repeat["max"].push_back(s.max);
+      for (const auto& [key, sum] : sums) per_repeat[key].push_back(sum / n);
+      const auto ratio = [&](const char* base, const char* key) {
+        const auto it = mean_ms.find({r.repeat, base});
+        if (it != mean_ms.end() && it->second > 0) per_repeat[key].push_back(s.mean / it->second);
+      };
+      ratio("vfc", "ratio_to_vfc");
+      ratio("oracle", "ratio_to_oracle");
+      a.missed_objects = std::max(a.missed_objects, missed);
+      a.frames_with_misses = std::max(a.frames_with_misses, frames_missing);
+      a.wrong_pixels = std::max(a.wrong_pixels, wrong);
+      a.worst_frame_wrong_pixels = std::max(a.worst_frame_wrong_pixels, worst);
+      a.longest_miss_frames = std::max(a.longest_miss_frames, r.longest_miss_frames);
+    }
+    const auto med = [&](const char* key) {
+      const auto it = per_repeat.find(key);
+      return it == per_repeat.end() ? 0.0 : median_of(it->second);
+    };
+    a.frame_ms = {med("mean"), med("median"), med("p95"), med("max")};
+    a.ratio_to_vfc = med("ratio_to_vfc");
+    a.ratio_to_oracle = med("ratio_to_oracle");
+    a.queries_per_frame = med("queries");
+    a.multiqueries_per_frame = med("multiqueries");
+    a.failed_multiqueries_per_frame = med("failed_multiqueries");
+    a.query_batches_per_frame = med("query_batches");
+    a.state_changes_per_frame = med("state_changes");
+    a.render_flushes_per_frame = med("render_flushes");
+    a.draw_calls_per_frame = med("draw_calls");
+    a.triangles_per_frame = med("triangles");
+    a.objects_rendered_per_frame = med("objects_rendered");
+    a.nodes_visited_per_frame = med("nodes_visited");
+    a.extra_objects_per_frame = med("extra_objects");
+    a.wait_ms_per_frame = med("wait_ms");
+    a.cpu_ms_per_frame = med("cpu_ms");
+    a.gpu_ms_per_frame = med("gpu_ms");
+    out.push_back(std::move(a));
+  }
+  return out;
+}
+
 BenchResult run_bench(const BenchConfig& config, const ProgressFn& progress) {
-  if (config.frames < 1) throw InputError("--frames must be at least 1");
-  if (config.warmup < 0) throw InputError("--warmup must not be negative");
+  if (config.frames < 1) throw InputError(fmt::format("--frames {}: must be at least 1", config.frames));
+  if (config.warmup < 0) throw InputError(fmt::format("--warmup {}: must not be negative", config.warmup));
+  if (config.repeat < 1) throw InputError(fmt::format("--repeat {}: must be at least 1", config.repeat));
   std::vector<std::string> names = config.algorithms;
   if (names.empty())
     for (const auto& a : algorithms()) names.push_back(a.name);
   // Validate names and options before the (slow) scene set-up.
-  for (const auto& n : names) (void)find_algorithm(n);
+  for (const auto& n : names) {
+    if (find_algorithm(n).harness_only && !config.verify)
+      throw InputError(fmt::format("{} needs ground truth: drop it or turn verification on", n));
+  }
   check_options(config.options);
+
   gl::RendererOptions ropts;
   ropts.width = config.width;
   ropts.height = config.height;
   ropts.query_mode = config.query_mode;
-  ropts.write_ids = false;
+  ropts.write_ids = false;  // timed frames draw colour and depth only
   ropts.multi_draw = config.multi_draw;
   Session session(config.scene, ropts);
   const CameraPath& path = config.path.empty() ? session.bundle().paths.front()
                                                : session.bundle().path(config.path);
+  for (const auto& n : names) (void)session.make(n, config.options);  // options of each, early
 
   BenchResult result;
   result.device = session.device();
+  result.commit = OCCULL_COMMIT;
   result.scene = config.scene;
   result.path = path.name();
   result.objects = session.bundle().scene.objects().size();
@@ -118,29 +301,44 @@ BenchResult run_bench(const BenchConfig& config, const ProgressFn& progress) {
   result.scene_build_ms = session.scene_build_ms();
   result.bvh_build_ms = session.bvh_build_ms();
   result.frames = config.frames;
+  result.warmup = config.warmup;
+  result.repeat = config.repeat;
+  result.verified = config.verify;
   result.width = config.width;
   result.height = config.height;
 
-  for (const auto& name : names) {
-    {
-      auto warm = make_culler(name, session.index(), config.options);
-      for (int k = 0; k < config.warmup; ++k) {
-        const int f = config.warmup > 1 ? k * (config.frames - 1) / (config.warmup - 1) : 0;
-        session.run_frame(*warm, session.view_at(path, f, config.frames),
-                          path.frame_time(f, config.frames));
-        if (progress) progress(name, k, config.warmup, true);
+  std::vector<FrameTruth> truth;
+  if (config.verify) truth = session.ground_truth(path, config.frames, progress);
+  const std::vector<FrameTruth>* truth_ptr = config.verify ? &truth : nullptr;
+
+  for (int rep = 0; rep < config.repeat; ++rep) {
+    for (const auto& name : names) {
+      const std::string label = config.repeat > 1 ? fmt::format("{} #{}", name, rep + 1) : name;
+      {
+        auto warm = session.make(name, config.options);
+        auto* oracle = dynamic_cast<detail::OracleCuller*>(warm.get());
+        for (int k = 0; k < config.warmup; ++k) {
+          const int f = config.warmup > 1 ? k * (config.frames - 1) / (config.warmup - 1) : 0;
+          if (oracle) {
+            std::vector<ObjectId> visible;
+            for (const auto& t : truth[std::size_t(f)]) visible.push_back(t.id);
+            oracle->set_visible(std::move(visible));
+          }
+          session.run_frame(*warm, session.view_at(path, f, config.frames),
+                            path.frame_time(f, config.frames));
+          if (progress) progress(label, k, config.warmup, true);
+        }
       }
+      auto culler = session.make(name, config.options);
+      AlgorithmRun run = session.run_path(name, *culler, path, config.frames, truth_ptr,
+                                          [&](std::string_view, int k, int n, bool w) {
+                                            if (progress) progress(label, k, n, w);
+                                          });
+      run.repeat = rep;
+      result.runs.push_back(std::move(run));
     }
-    AlgorithmRun run{name, {}};
-    run.frames.reserve(std::size_t(config.frames));
-    auto culler = make_culler(name, session.index(), config.options);
-    for (int k = 0; k < config.frames; ++k) {
-      run.frames.push_back(session.run_frame(*culler, session.view_at(path, k, config.frames),
-                                             path.frame_time(k, config.frames)));
-      if (progress) progress(name, k, config.frames, false);
-    }
-    result.runs.push_back(std::move(run));
   }
+  result.summaries = summarize_runs(result.runs);
   return result;
 }
 

@@ -1,60 +1,229 @@
-#include "occull/harness.hpp"
+#include "occull/report.hpp"
+
+#include "occull/error.hpp"
+#include "svg_chart.hpp"
 
 #include <fmt/format.h>
+#include <nlohmann/json.hpp>
 
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
 #include <ostream>
+#include <sstream>
 
 namespace occull {
 namespace {
 
-template <typename F>
-double mean_of(const AlgorithmRun& run, F field) {
-  if (run.frames.empty()) return 0.0;
-  double sum = 0.0;
-  for (const FrameStats& f : run.frames) sum += double(field(f));
-  return sum / double(run.frames.size());
+std::string ratio_text(double r) { return r > 0 ? fmt::format("{:.2f}", r) : "-"; }
+
+// Per frame, the median over repeats of one figure of one algorithm.
+std::vector<double> per_frame_median(const BenchResult& r, const std::string& name,
+                                     double (*field)(const FrameStats&)) {
+  std::vector<std::vector<double>> values;
+  for (const AlgorithmRun& run : r.runs) {
+    if (run.name != name) continue;
+    if (values.size() < run.frames.size()) values.resize(run.frames.size());
+    for (std::size_t k = 0; k < run.frames.size(); ++k) values[k].push_back(field(run.frames[k]));
+  }
+  std::vector<double> out;
+  for (auto& v : values) out.push_back(summarize(v).median);
+  return out;
 }
 
-std::vector<double> frame_times(const AlgorithmRun& run) {
-  std::vector<double> v;
-  v.reserve(run.frames.size());
-  for (const FrameStats& f : run.frames) v.push_back(f.frame_ms);
-  return v;
+detail::LineChart chart(const BenchResult& r, std::string title, std::string y_label,
+                        double (*field)(const FrameStats&)) {
+  detail::LineChart c;
+  c.title = std::move(title);
+  c.x_label = "frame";
+  c.y_label = std::move(y_label);
+  for (const AlgorithmSummary& a : r.summaries)
+    c.series.push_back({a.name, per_frame_median(r, a.name, field)});
+  return c;
+}
+
+std::string setup_line(const BenchResult& r) {
+  return fmt::format("scene {} ({} objects, {} triangles; BVH {} nodes in {:.1f} ms), path {}, {} frames "
+                     "at {}x{}, {} warm-up, {} repeat{}, verification {}",
+                     r.scene, r.objects, r.triangles, r.bvh_nodes, r.bvh_build_ms, r.path, r.frames,
+                     r.width, r.height, r.warmup, r.repeat, r.repeat == 1 ? "" : "s",
+                     r.verified ? "on" : "off");
+}
+
+std::string misses_text(const BenchResult& r, std::uint64_t v) {
+  return r.verified ? fmt::format("{}", v) : "-";
 }
 
 }  // namespace
 
 void print_table(const BenchResult& r, std::ostream& out) {
-  out << fmt::format("scene {} ({} objects, {} triangles, BVH {} nodes built in {:.1f} ms), path {}, "
-                     "{} frames at {}x{}\n",
-                     r.scene, r.objects, r.triangles, r.bvh_nodes, r.bvh_build_ms, r.path, r.frames,
-                     r.width, r.height);
-  out << fmt::format("device: {} | {}\n\n", r.device.renderer, r.device.version);
-  const AlgorithmRun* vfc = nullptr;
-  for (const auto& run : r.runs)
-    if (run.name == "vfc") vfc = &run;
-  const double vfc_mean = vfc ? summarize(frame_times(*vfc)).mean : 0.0;
-
-  out << fmt::format("{:<10} {:>8} {:>8} {:>8} {:>8} {:>7} {:>8} {:>10} {:>8} {:>8} {:>8}\n",
-                     "algorithm", "mean ms", "median", "p95", "max", "vs vfc", "draws", "triangles",
-                     "objects", "cpu ms", "gpu ms");
-  for (const auto& run : r.runs) {
-    const Summary s = summarize(frame_times(run));
-    const std::string ratio = vfc_mean > 0 ? fmt::format("{:.2f}", s.mean / vfc_mean) : "-";
-    out << fmt::format("{:<10} {:>8.2f} {:>8.2f} {:>8.2f} {:>8.2f} {:>7} {:>8.0f} {:>10.0f} {:>8.0f} {:>8.3f} {:>8.2f}\n",
-                       run.name, s.mean, s.median, s.p95, s.max, ratio,
-                       mean_of(run, [](const FrameStats& f) { return f.draw_calls; }),
-                       mean_of(run, [](const FrameStats& f) { return f.triangles; }),
-                       mean_of(run, [](const FrameStats& f) { return f.objects_rendered; }),
-                       mean_of(run, [](const FrameStats& f) { return f.cpu_ms; }),
-                       mean_of(run, [](const FrameStats& f) { return f.gpu_ms; }));
+  out << setup_line(r) << "\n";
+  out << fmt::format("device: {} | {} | occull {}\n\n", r.device.renderer, r.device.version, r.commit);
+  out << fmt::format("{:<10} {:>8} {:>8} {:>8} {:>8} {:>6} {:>7} {:>8} {:>7} {:>7} {:>10} {:>7} {:>9}\n",
+                     "algorithm", "mean ms", "median", "p95", "max", "vs vfc", "vs orcl", "queries",
+                     "states", "draws", "triangles", "missed", "wrong px");
+  for (const AlgorithmSummary& a : r.summaries) {
+    out << fmt::format(
+        "{:<10} {:>8.2f} {:>8.2f} {:>8.2f} {:>8.2f} {:>6} {:>7} {:>8.1f} {:>7.1f} {:>7.0f} {:>10.0f} "
+        "{:>7} {:>9}\n",
+        a.name, a.frame_ms.mean, a.frame_ms.median, a.frame_ms.p95, a.frame_ms.max,
+        ratio_text(a.ratio_to_vfc), ratio_text(a.ratio_to_oracle), a.queries_per_frame,
+        a.state_changes_per_frame, a.draw_calls_per_frame, a.triangles_per_frame,
+        misses_text(r, a.missed_objects), misses_text(r, a.wrong_pixels));
   }
-  out << "\nper frame (means): draws, triangles, objects; cpu ms = the culler's own CPU time; "
-         "gpu ms = timer query over the frame.\nvs vfc = mean frame time / vfc's mean frame time "
-         "in this run.\n";
-  if (r.device.renderer.find("llvmpipe") != std::string::npos)
-    out << "note: llvmpipe's GL_TIME_ELAPSED leaves out most of its (deferred, multi-threaded) "
-           "rasterization; judge by wall-clock frame times.\n";
+  out << "\nframe ms: wall clock per frame (glFinish closes it)"
+      << (r.repeat > 1 ? ", median over repeats" : "")
+      << "; vs vfc / vs orcl: mean frame time over vfc's / oracle's in the same run.\n"
+         "queries, states (render<->query switches), draws, triangles: per frame. missed: objects "
+         "visible in the ground truth but not rendered, summed over frames; wrong px: their pixels.\n";
+}
+
+void write_json(const BenchResult& r, std::ostream& out) {
+  using nlohmann::ordered_json;
+  ordered_json doc;
+  doc["device"] = {{"vendor", r.device.vendor},
+                   {"renderer", r.device.renderer},
+                   {"version", r.device.version},
+                   {"egl_platform", r.device.egl_platform}};
+  doc["occull_commit"] = r.commit;
+  doc["scene"] = {{"name", r.scene},
+                  {"objects", r.objects},
+                  {"triangles", r.triangles},
+                  {"bvh_nodes", r.bvh_nodes},
+                  {"bvh_build_ms", r.bvh_build_ms}};
+  doc["path"] = r.path;
+  doc["frames"] = r.frames;
+  doc["warmup"] = r.warmup;
+  doc["repeat"] = r.repeat;
+  doc["verified"] = r.verified;
+  doc["size"] = {r.width, r.height};
+  ordered_json algos = ordered_json::array();
+  for (const AlgorithmSummary& a : r.summaries) {
+    algos.push_back({{"name", a.name},
+                     {"frame_ms",
+                      {{"mean", a.frame_ms.mean},
+                       {"median", a.frame_ms.median},
+                       {"p95", a.frame_ms.p95},
+                       {"max", a.frame_ms.max}}},
+                     {"ratio_to_vfc", a.ratio_to_vfc > 0 ? ordered_json(a.ratio_to_vfc) : ordered_json()},
+                     {"ratio_to_oracle",
+                      a.ratio_to_oracle > 0 ? ordered_json(a.ratio_to_oracle) : ordered_json()},
+                     {"queries_per_frame", a.queries_per_frame},
+                     {"multiqueries_per_frame", a.multiqueries_per_frame},
+                     {"failed_multiqueries_per_frame", a.failed_multiqueries_per_frame},
+                     {"query_batches_per_frame", a.query_batches_per_frame},
+                     {"state_changes_per_frame", a.state_changes_per_frame},
+                     {"render_flushes_per_frame", a.render_flushes_per_frame},
+                     {"draw_calls_per_frame", a.draw_calls_per_frame},
+                     {"triangles_per_frame", a.triangles_per_frame},
+                     {"objects_rendered_per_frame", a.objects_rendered_per_frame},
+                     {"nodes_visited_per_frame", a.nodes_visited_per_frame},
+                     {"extra_objects_per_frame", a.extra_objects_per_frame},
+                     {"missed_objects", a.missed_objects},
+                     {"frames_with_misses", a.frames_with_misses},
+                     {"wrong_pixels", a.wrong_pixels},
+                     {"worst_frame_wrong_pixels", a.worst_frame_wrong_pixels},
+                     {"longest_miss_frames", a.longest_miss_frames},
+                     {"wait_ms_per_frame", a.wait_ms_per_frame},
+                     {"cpu_ms_per_frame", a.cpu_ms_per_frame},
+                     {"gpu_ms_per_frame", a.gpu_ms_per_frame}});
+  }
+  doc["algorithms"] = algos;
+  out << doc.dump(2) << "\n";
+}
+
+void write_csv(const BenchResult& r, std::ostream& out) {
+  out << "algorithm,repeat,frame,frame_ms,cpu_ms,wait_ms,gpu_ms,queries,query_boxes,multiqueries,"
+         "failed_multiqueries,query_batches,state_changes,material_changes,render_flushes,"
+         "draw_calls,triangles,objects_rendered,nodes_visited,truth_objects,missed_objects,"
+         "wrong_pixels,extra_objects\n";
+  for (const AlgorithmRun& run : r.runs) {
+    for (std::size_t k = 0; k < run.frames.size(); ++k) {
+      const FrameStats& f = run.frames[k];
+      out << fmt::format("{},{},{},{:.4f},{:.4f},{:.4f},{:.4f},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n",
+                         run.name, run.repeat, k, f.frame_ms, f.cpu_ms, f.wait_ms, f.gpu_ms, f.queries,
+                         f.query_boxes, f.multiqueries, f.failed_multiqueries, f.query_batches,
+                         f.state_changes, f.material_changes, f.render_flushes, f.draw_calls,
+                         f.triangles, f.objects_rendered, f.nodes_visited, f.truth_objects,
+                         f.missed_objects, f.wrong_pixels, f.extra_objects);
+    }
+  }
+}
+
+void prepare_report_folder(const std::string& dir) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  fs::create_directories(dir, ec);
+  if (ec) throw InputError(fmt::format("cannot create report folder '{}': {}", dir, ec.message()));
+  const fs::path probe = fs::path(dir) / ".occull-write-test";
+  {
+    std::ofstream f(probe);
+    f << "x";
+    if (!f) throw InputError(fmt::format("cannot write into report folder '{}'", dir));
+  }
+  fs::remove(probe, ec);
+}
+
+std::vector<std::string> write_report(const BenchResult& r, const std::string& dir) {
+  namespace fs = std::filesystem;
+  prepare_report_folder(dir);
+  std::vector<std::string> written;
+  const auto write = [&](const std::string& name, const std::string& text) {
+    const std::string path = (fs::path(dir) / name).string();
+    std::ofstream f(path, std::ios::binary);
+    f << text;
+    if (!f) throw InputError(fmt::format("cannot write '{}'", path));
+    written.push_back(path);
+  };
+
+  const detail::LineChart frame_chart = chart(r, fmt::format("Frame time — {} / {}", r.scene, r.path),
+                                              "frame time (ms)", [](const FrameStats& f) { return f.frame_ms; });
+  write("frame_ms.svg", detail::render_svg(frame_chart));
+  write("queries.svg", detail::render_svg(chart(r, fmt::format("Occlusion queries — {} / {}", r.scene, r.path),
+                                                "queries per frame",
+                                                [](const FrameStats& f) { return double(f.queries); })));
+  write("triangles.svg", detail::render_svg(chart(r, fmt::format("Triangles rendered — {} / {}", r.scene, r.path),
+                                                  "triangles per frame",
+                                                  [](const FrameStats& f) { return double(f.triangles); })));
+  std::ostringstream json, csv, table;
+  write_json(r, json);
+  write("results.json", json.str());
+  write_csv(r, csv);
+  write("frames.csv", csv.str());
+
+  std::string md = "# occull benchmark report\n\n## Set-up\n\n";
+  md += fmt::format("- renderer: {} ({}), OpenGL {}\n", r.device.renderer, r.device.vendor, r.device.version);
+  md += fmt::format("- scene: `{}` — {} objects, {} triangles (BVH {} nodes)\n", r.scene, r.objects,
+                    r.triangles, r.bvh_nodes);
+  md += fmt::format("- path: `{}`, {} frames at {}×{}, {} warm-up frames per algorithm\n", r.path, r.frames,
+                    r.width, r.height, r.warmup);
+  md += fmt::format("- repeats: {} (algorithms interleaved; figures are medians over repeats)\n", r.repeat);
+  md += fmt::format("- verification against ground truth: {}\n", r.verified ? "on" : "off");
+  md += fmt::format("- occull commit: `{}`\n\n## Results\n\n", r.commit);
+  md += "| algorithm | mean ms | median | p95 | max | vs vfc | vs oracle | queries | state changes | "
+        "draws | triangles | missed | frames w/ miss | wrong px | longest miss | extra objects | "
+        "wait ms | cpu ms |\n";
+  md += "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
+  for (const AlgorithmSummary& a : r.summaries) {
+    md += fmt::format("| {} | {:.2f} | {:.2f} | {:.2f} | {:.2f} | {} | {} | {:.1f} | {:.1f} | {:.0f} | {:.0f} | "
+                      "{} | {} | {} | {} | {:.1f} | {:.3f} | {:.3f} |\n",
+                      a.name, a.frame_ms.mean, a.frame_ms.median, a.frame_ms.p95, a.frame_ms.max,
+                      ratio_text(a.ratio_to_vfc), ratio_text(a.ratio_to_oracle), a.queries_per_frame,
+                      a.state_changes_per_frame, a.draw_calls_per_frame, a.triangles_per_frame,
+                      misses_text(r, a.missed_objects), misses_text(r, a.frames_with_misses),
+                      misses_text(r, a.wrong_pixels), misses_text(r, a.longest_miss_frames),
+                      a.extra_objects_per_frame, a.wait_ms_per_frame, a.cpu_ms_per_frame);
+  }
+  md += "\nFrame times are wall clock, each frame closed by `glFinish`; ratios compare means measured in "
+        "the same run. *missed* counts objects visible in the ground truth (object-id buffer of "
+        "everything in the frustum) that the algorithm did not render, summed over frames; *wrong px* "
+        "are their pixels; *longest miss* is the longest run of frames one object stayed missed; *extra "
+        "objects* were rendered without being visible (the culling's inefficiency).\n\n";
+  md += "![frame time per frame](frame_ms.svg)\n\n![queries per frame](queries.svg)\n\n"
+        "![triangles per frame](triangles.svg)\n\n";
+  md += "Raw data: [results.json](results.json), [frames.csv](frames.csv).\n";
+  write("report.md", md);
+  return written;
 }
 
 }  // namespace occull

@@ -161,6 +161,9 @@ struct Renderer::Impl {
   glm::vec3 eye{0.0f};
   std::vector<ObjectId> opaque;
   std::vector<ObjectId> translucent;  // deferred to end_frame
+  std::vector<ObjectId> frame_objects;  // everything render() got this frame
+  GLuint truth_query = 0;             // GL_SAMPLES_PASSED, for visible_pixels only
+  std::vector<std::uint32_t> pixel_counts;  // per object, scratch of visible_pixels
   GLuint indirect_buffer = 0;         // multi-draw commands, refilled every frame
   GLsizeiptr indirect_capacity = 0, indirect_offset = 0;
   std::vector<DrawCommand> commands;
@@ -324,6 +327,7 @@ void Renderer::Impl::create_query_resources() {
   glGetQueryiv(GL_TIME_ELAPSED, GL_QUERY_COUNTER_BITS, &bits);
   timer_supported = bits > 0;
   if (timer_supported) glCreateQueries(GL_TIME_ELAPSED, 1, &timer);
+  glCreateQueries(GL_SAMPLES_PASSED, 1, &truth_query);
 }
 
 void Renderer::Impl::enter_render_state(BackendStats& stats) {
@@ -435,6 +439,7 @@ Renderer::~Renderer() {
   if (!g.query_names.empty())
     glDeleteQueries(GLsizei(g.query_names.size()), g.query_names.data());
   if (g.timer) glDeleteQueries(1, &g.timer);
+  glDeleteQueries(1, &g.truth_query);
   const GLuint buffers[] = {g.vertex_buffer, g.index_buffer, g.object_index_buffer,
                             g.object_buffer, g.material_buffer, g.cube_vertices,
                             g.cube_indices,  g.box_buffer,          g.indirect_buffer};
@@ -471,6 +476,7 @@ void Renderer::begin_frame(const View& view) {
   glProgramUniform1f(g.scene_program, g.u_fog, std::max(view.far, 1.0f));
   g.eye = view.eye;
   g.translucent.clear();
+  g.frame_objects.clear();
   g.bound_material = ~0u;
   // Start every frame in render state without counting it as a change.
   g.mode = Impl::Mode::none;
@@ -522,6 +528,7 @@ void Renderer::render(std::span<const ObjectId> objects) {
   Impl& g = *impl_;
   ScopedTimer timer(stats_.backend_ms);
   ++stats_.render_flushes;
+  g.frame_objects.insert(g.frame_objects.end(), objects.begin(), objects.end());
   g.opaque.clear();
   for (ObjectId id : objects) {
     if (g.scene.material(g.scene.object(id).material).translucent)
@@ -631,6 +638,56 @@ std::vector<std::uint8_t> Renderer::read_rgba() const {
                      pixels.begin() + long(std::size_t(y + 1) * row),
                      pixels.begin() + long(std::size_t(g.options.height - 1 - y) * row));
   return pixels;
+}
+
+std::span<const ObjectId> Renderer::frame_objects() const noexcept { return impl_->frame_objects; }
+
+std::vector<Renderer::ObjectPixels> Renderer::visible_pixels(const View& view,
+                                                             std::span<const ObjectId> objects) {
+  Impl& g = *impl_;
+  const BackendStats saved_stats = stats_;
+  const bool saved_ids = g.write_ids;
+  set_write_ids(true);
+  begin_frame(view);
+  g.opaque.clear();
+  std::vector<ObjectId> translucent;
+  for (ObjectId id : objects)
+    (g.scene.material(g.scene.object(id).material).translucent ? translucent : g.opaque).push_back(id);
+  g.draw_objects(g.opaque, stats_);
+
+  std::vector<std::uint64_t> samples(translucent.size());
+  if (!translucent.empty()) {
+    // Depth test against the opaque scene, no writes at all.
+    glDepthMask(GL_FALSE);
+    glColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
+    glColorMaski(1, GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
+    for (std::size_t i = 0; i < translucent.size(); ++i) {
+      glBeginQuery(GL_SAMPLES_PASSED, g.truth_query);
+      g.draw_objects(std::span<const ObjectId>(&translucent[i], 1), stats_);
+      glEndQuery(GL_SAMPLES_PASSED);
+      GLuint64 n = 0;
+      glGetQueryObjectui64v(g.truth_query, GL_QUERY_RESULT, &n);
+      samples[i] = n;
+    }
+    glColorMaski(1, GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+    glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+    glDepthMask(GL_TRUE);
+  }
+  end_frame();
+
+  g.pixel_counts.assign(g.scene.objects().size(), 0);
+  for (std::uint32_t v : read_ids())
+    if (v != 0) ++g.pixel_counts[v - 1];
+  for (std::size_t i = 0; i < translucent.size(); ++i)
+    g.pixel_counts[translucent[i]] = std::uint32_t(std::min<std::uint64_t>(samples[i], 0xffffffffu));
+  std::vector<ObjectPixels> visible;
+  for (ObjectId id = 0; id < g.pixel_counts.size(); ++id)
+    if (g.pixel_counts[id] > 0) visible.push_back({id, g.pixel_counts[id]});
+
+  set_write_ids(saved_ids);
+  g.frame_objects.clear();
+  stats_ = saved_stats;
+  return visible;
 }
 
 std::size_t Renderer::queries_in_flight() const noexcept { return impl_->in_flight; }

@@ -76,6 +76,25 @@ class Renderer final : public Backend {
   void flush() override;
   [[nodiscard]] BackendStats stats() const override { return stats_; }
 
+  /// Objects passed to render() since begin_frame(), in call order
+  /// (translucent ones included).
+  [[nodiscard]] std::span<const ObjectId> frame_objects() const noexcept;
+
+  /// One object's visible area in a visible_pixels() pass.
+  struct ObjectPixels {
+    ObjectId id;
+    std::uint32_t pixels;  ///< opaque: id-buffer pixels; translucent: samples passing the depth test
+  };
+  /// Untimed measuring pass (ground truth): draws `objects` for `view` into
+  /// the depth and id targets and returns, sorted by id, every object with
+  /// at least one visible pixel. Opaque objects count the pixels they own in
+  /// the id buffer; translucent ones (which never occlude) are tested with
+  /// one occlusion query over their own triangles after all opaque ones.
+  /// Overwrites the frame's targets; does not count in stats(). Call it
+  /// outside begin_frame()/end_frame().
+  [[nodiscard]] std::vector<ObjectPixels> visible_pixels(const View& view,
+                                                         std::span<const ObjectId> objects);
+
   /// Writing object ids can be switched off (timed runs that do not verify).
   void set_write_ids(bool on);
   /// The object-id target after end_frame(): width*height values, bottom

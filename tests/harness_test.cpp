@@ -1,0 +1,288 @@
+// Ground truth, verification, the oracle and the report writers.
+#include "occull/harness.hpp"
+#include "occull/error.hpp"
+#include "occull/report.hpp"
+#include "test_util.hpp"
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+#include <tinyxml2.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <map>
+#include <optional>
+#include <sstream>
+
+using namespace occull;
+
+namespace {
+
+constexpr const char* kSmallCity = "city:blocks=3,traffic=6";
+
+gl::RendererOptions small_target() {
+  gl::RendererOptions o;
+  o.width = 160;
+  o.height = 90;
+  o.write_ids = false;
+  return o;
+}
+
+// Renders what an inner culler renders, minus one object.
+class DroppingCuller final : public Culler {
+ public:
+  DroppingCuller(std::unique_ptr<Culler> inner, ObjectId dropped)
+      : inner_(std::move(inner)), dropped_(dropped) {}
+  FrameStats render_frame(const View& view, Backend& backend) override {
+    Filter filter(backend, dropped_);
+    return inner_->render_frame(view, filter);
+  }
+
+ private:
+  struct Filter final : Backend {
+    Filter(Backend& b, ObjectId d) : inner(b), dropped(d) {}
+    void render(std::span<const ObjectId> objects) override {
+      std::vector<ObjectId> kept;
+      for (ObjectId id : objects)
+        if (id != dropped) kept.push_back(id);
+      inner.render(kept);
+    }
+    QueryId issue_query(std::span<const Aabb> boxes) override { return inner.issue_query(boxes); }
+    bool result_available(QueryId q) override { return inner.result_available(q); }
+    std::uint64_t result(QueryId q) override { return inner.result(q); }
+    BackendStats stats() const override { return inner.stats(); }
+    Backend& inner;
+    ObjectId dropped;
+  };
+  std::unique_ptr<Culler> inner_;
+  ObjectId dropped_;
+};
+
+// An object visible in every frame of the truth, if any.
+std::optional<ObjectId> always_visible(const std::vector<FrameTruth>& truth) {
+  std::map<ObjectId, std::size_t> frames;
+  for (const FrameTruth& t : truth)
+    for (const auto& o : t) ++frames[o.id];
+  for (const auto& [id, n] : frames)
+    if (n == truth.size()) return id;
+  return std::nullopt;
+}
+
+class HarnessTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    session_ = std::make_unique<Session>(kSmallCity, small_target());
+    path_ = &session_->bundle().path("turn");
+    truth_ = session_->ground_truth(*path_, kFrames);
+  }
+  static void TearDownTestSuite() { session_.reset(); }
+  static constexpr int kFrames = 12;
+  static std::unique_ptr<Session> session_;
+  static const CameraPath* path_;
+  static std::vector<FrameTruth> truth_;
+};
+std::unique_ptr<Session> HarnessTest::session_;
+const CameraPath* HarnessTest::path_ = nullptr;
+std::vector<FrameTruth> HarnessTest::truth_;
+
+}  // namespace
+
+TEST(CheckFrame, CountsMissedWrongPixelsAndExtraObjects) {
+  const std::vector<gl::Renderer::ObjectPixels> truth{{1, 100}, {4, 7}, {5, 30}};
+  const std::vector<ObjectId> rendered{1, 2, 2, 5, 6};
+  FrameStats s;
+  const auto missed = check_frame(truth, rendered, 8, s);
+  EXPECT_EQ(missed, std::vector<ObjectId>{4});
+  EXPECT_EQ(s.truth_objects, 3u);
+  EXPECT_EQ(s.missed_objects, 1u);
+  EXPECT_EQ(s.wrong_pixels, 7u);
+  EXPECT_EQ(s.extra_objects, 2u);  // 2 and 6; duplicates count once
+}
+
+TEST(SummarizeRuns, MediansOverRepeatsAndRatiosWithinARepeat) {
+  const auto run = [](const char* name, int rep, std::vector<double> ms, std::uint32_t missed) {
+    AlgorithmRun r{name, rep, {}, 0};
+    for (double m : ms) {
+      FrameStats f;
+      f.frame_ms = m;
+      f.queries = 10;
+      f.missed_objects = missed;
+      r.frames.push_back(f);
+    }
+    return r;
+  };
+  // Repeat 1 ran on a machine twice as slow: ratios stay 0.5.
+  const std::vector<AlgorithmRun> runs{run("vfc", 0, {10, 10}, 0), run("fast", 0, {5, 5}, 0),
+                                       run("vfc", 1, {20, 20}, 0), run("fast", 1, {10, 10}, 1),
+                                       run("vfc", 2, {12, 12}, 0), run("fast", 2, {6, 6}, 0)};
+  const auto s = summarize_runs(runs);
+  ASSERT_EQ(s.size(), 2u);
+  EXPECT_EQ(s[0].name, "vfc");
+  EXPECT_DOUBLE_EQ(s[0].frame_ms.mean, 12.0);
+  EXPECT_DOUBLE_EQ(s[1].ratio_to_vfc, 0.5);
+  EXPECT_DOUBLE_EQ(s[1].queries_per_frame, 10.0);
+  EXPECT_EQ(s[1].missed_objects, 2u);  // the worst repeat
+  EXPECT_EQ(s[1].ratio_to_oracle, 0.0);
+}
+
+TEST(Summarize, MeanMedianPercentileMax) {
+  std::vector<double> v;
+  for (int i = 1; i <= 100; ++i) v.push_back(i);
+  const Summary s = summarize(v);
+  EXPECT_DOUBLE_EQ(s.mean, 50.5);
+  EXPECT_DOUBLE_EQ(s.median, 50.5);
+  EXPECT_DOUBLE_EQ(s.p95, 95.0);
+  EXPECT_DOUBLE_EQ(s.max, 100.0);
+}
+
+TEST(GroundTruth, WallHidesTheBoxBehindItNotTheOneBeside) {
+  auto context = gl::Context::create();
+  const Scene scene = test::box_scene({{{-3, -3, -11}, {3, 3, -10}},   // wall
+                                       {{-1, -1, -21}, {1, 1, -19}},   // behind it
+                                       {{7, -1, -21}, {9, 1, -19}},    // beside it
+                                       {{-1, -1, 5}, {1, 1, 7}}});     // behind the camera
+  gl::RendererOptions o;
+  o.width = o.height = 128;
+  gl::Renderer r(scene, o);
+  const View view = make_view({{0, 0, 0}, 0, 0}, {60.0f, 0.1f, 100.0f}, 128, 128);
+  const ObjectId all[] = {0, 1, 2, 3};
+  const auto visible = r.visible_pixels(view, all);
+  ASSERT_EQ(visible.size(), 2u);
+  EXPECT_EQ(visible[0].id, 0u);
+  EXPECT_EQ(visible[1].id, 2u);
+  EXPECT_GT(visible[0].pixels, visible[1].pixels);  // the near wall is bigger on screen
+  EXPECT_EQ(r.stats().draw_calls, 0u) << "the truth pass is not counted";
+}
+
+TEST(GroundTruth, TranslucentObjectsAreVisibleWithoutHidingWhatIsBehind) {
+  auto context = gl::Context::create();
+  Scene scene("glass");
+  const MaterialId glass = scene.add_material({"glass", {0.5f, 0.8f, 1.0f, 0.3f}, true, 0});
+  const MaterialId grey = scene.add_material({"grey", {0.6f, 0.6f, 0.6f, 1.0f}, false, 0});
+  scene.add_object(scene.add_mesh(test::box_mesh({{-3, -3, -11}, {3, 3, -10}})), glass, glm::mat4(1),
+                   OccluderClass::never);
+  scene.add_object(scene.add_mesh(test::box_mesh({{-1, -1, -21}, {1, 1, -19}})), grey, glm::mat4(1),
+                   OccluderClass::always);
+  scene.add_object(scene.add_mesh(test::box_mesh({{-0.5f, -0.5f, -40}, {0.5f, 0.5f, -39}})), glass,
+                   glm::mat4(1), OccluderClass::never);  // glass behind the grey box: hidden
+  gl::RendererOptions o;
+  o.width = o.height = 128;
+  gl::Renderer r(scene, o);
+  const View view = make_view({{0, 0, 0}, 0, 0}, {60.0f, 0.1f, 100.0f}, 128, 128);
+  const ObjectId all[] = {0, 1, 2};
+  const auto visible = r.visible_pixels(view, all);
+  ASSERT_EQ(visible.size(), 2u);
+  EXPECT_EQ(visible[0].id, 0u);
+  EXPECT_EQ(visible[1].id, 1u);
+}
+
+TEST_F(HarnessTest, TruthIsNonEmptyAndSortedForEveryFrame) {
+  ASSERT_EQ(truth_.size(), std::size_t(kFrames));
+  for (const FrameTruth& t : truth_) {
+    EXPECT_FALSE(t.empty());
+    EXPECT_TRUE(std::is_sorted(t.begin(), t.end(), [](auto& a, auto& b) { return a.id < b.id; }));
+  }
+}
+
+TEST_F(HarnessTest, VfcAndNoneMissNothing) {
+  for (const char* name : {"none", "vfc"}) {
+    auto culler = session_->make(name, {});
+    const AlgorithmRun run = session_->run_path(name, *culler, *path_, kFrames, &truth_);
+    for (const FrameStats& f : run.frames) {
+      EXPECT_EQ(f.missed_objects, 0u) << name;
+      EXPECT_EQ(f.wrong_pixels, 0u) << name;
+      EXPECT_GT(f.truth_objects, 0u);
+    }
+    EXPECT_EQ(run.longest_miss_frames, 0u);
+  }
+}
+
+TEST_F(HarnessTest, OracleRendersExactlyTheTruth) {
+  auto oracle = session_->make("oracle", {});
+  const AlgorithmRun run = session_->run_path("oracle", *oracle, *path_, kFrames, &truth_);
+  for (std::size_t k = 0; k < run.frames.size(); ++k) {
+    EXPECT_EQ(run.frames[k].missed_objects, 0u);
+    EXPECT_EQ(run.frames[k].extra_objects, 0u);
+    EXPECT_EQ(run.frames[k].objects_rendered, truth_[k].size());
+    EXPECT_EQ(run.frames[k].queries, 0u);
+  }
+}
+
+TEST_F(HarnessTest, VerificationCatchesACullerThatDropsAVisibleObject) {
+  const auto victim = always_visible(truth_);
+  ASSERT_TRUE(victim.has_value()) << "the turn path keeps the crossing under the camera in view";
+  DroppingCuller broken(session_->make("vfc", {}), *victim);
+  const AlgorithmRun run = session_->run_path("broken", broken, *path_, kFrames, &truth_);
+  std::uint64_t missed = 0, wrong = 0;
+  for (const FrameStats& f : run.frames) {
+    EXPECT_EQ(f.missed_objects, 1u);
+    missed += f.missed_objects;
+    wrong += f.wrong_pixels;
+  }
+  EXPECT_EQ(missed, std::uint64_t(kFrames));
+  EXPECT_GT(wrong, 0u);
+  EXPECT_EQ(run.longest_miss_frames, std::uint32_t(kFrames));
+  const auto summary = summarize_runs(std::span<const AlgorithmRun>(&run, 1));
+  EXPECT_EQ(summary[0].frames_with_misses, std::uint64_t(kFrames));
+}
+
+TEST_F(HarnessTest, OracleWithoutTruthIsRefused) {
+  auto oracle = session_->make("oracle", {});
+  EXPECT_THROW(session_->run_path("oracle", *oracle, *path_, 2, nullptr), InputError);
+}
+
+TEST(Report, JsonCarriesEveryDocumentedField) {
+  BenchConfig c;
+  c.scene = kSmallCity;
+  c.algorithms = {"vfc", "oracle", "none"};
+  c.frames = 4;
+  c.warmup = 1;
+  c.repeat = 2;
+  c.width = 96;
+  c.height = 54;
+  const BenchResult r = run_bench(c);
+  EXPECT_EQ(r.runs.size(), 6u);
+  EXPECT_EQ(r.runs[3].name, "vfc");  // interleaved: A B C A B C
+  std::ostringstream out;
+  write_json(r, out);
+  const auto doc = nlohmann::json::parse(out.str());
+  EXPECT_TRUE(doc["device"].contains("renderer"));
+  EXPECT_TRUE(doc["device"].contains("version"));
+  EXPECT_EQ(doc["scene"]["name"], kSmallCity);
+  EXPECT_GT(doc["scene"]["objects"].get<int>(), 0);
+  EXPECT_GT(doc["scene"]["triangles"].get<int>(), 0);
+  EXPECT_EQ(doc["path"], "street");
+  EXPECT_EQ(doc["frames"], 4);
+  EXPECT_EQ(doc["size"], nlohmann::json::array({96, 54}));
+  ASSERT_EQ(doc["algorithms"].size(), 3u);
+  for (const auto& a : doc["algorithms"]) {
+    for (const char* key : {"name", "frame_ms", "ratio_to_vfc", "ratio_to_oracle", "queries_per_frame",
+                            "multiqueries_per_frame", "state_changes_per_frame", "draw_calls_per_frame",
+                            "triangles_per_frame", "objects_rendered_per_frame", "missed_objects",
+                            "frames_with_misses", "wrong_pixels", "longest_miss_frames",
+                            "wait_ms_per_frame", "cpu_ms_per_frame"})
+      EXPECT_TRUE(a.contains(key)) << key;
+    for (const char* key : {"mean", "median", "p95", "max"}) EXPECT_TRUE(a["frame_ms"].contains(key));
+    EXPECT_EQ(a["missed_objects"], 0);
+  }
+  EXPECT_DOUBLE_EQ(doc["algorithms"][0]["ratio_to_vfc"].get<double>(), 1.0);
+  EXPECT_DOUBLE_EQ(doc["algorithms"][1]["ratio_to_oracle"].get<double>(), 1.0);
+
+  // CSV: a header and one row per algorithm, repeat and frame.
+  std::ostringstream csv;
+  write_csv(r, csv);
+  const std::string text = csv.str();
+  EXPECT_EQ(std::count(text.begin(), text.end(), '\n'), 1 + 6 * 4);
+
+  // Report folder: Markdown plus well-formed SVG charts.
+  const std::string dir = ::testing::TempDir() + "occull_report_test";
+  std::filesystem::remove_all(dir);
+  const auto files = write_report(r, dir);
+  EXPECT_EQ(files.size(), 6u);
+  for (const char* svg : {"frame_ms.svg", "queries.svg", "triangles.svg"}) {
+    tinyxml2::XMLDocument xml;
+    ASSERT_EQ(xml.LoadFile((dir + "/" + svg).c_str()), tinyxml2::XML_SUCCESS) << svg << ": " << xml.ErrorStr();
+    EXPECT_STREQ(xml.RootElement()->Name(), "svg");
+  }
+  EXPECT_TRUE(std::filesystem::exists(dir + "/report.md"));
+}
