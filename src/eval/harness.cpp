@@ -11,9 +11,7 @@
 #include <map>
 #include <numeric>
 
-#ifndef OCCULL_COMMIT
-#define OCCULL_COMMIT "unknown"
-#endif
+#include "occull_commit.hpp"  // generated: OCCULL_COMMIT
 
 namespace occull {
 namespace {
