@@ -156,15 +156,7 @@ TEST(GroundTruth, WallHidesTheBoxBehindItNotTheOneBeside) {
 
 TEST(GroundTruth, TranslucentObjectsAreVisibleWithoutHidingWhatIsBehind) {
   auto context = gl::Context::create();
-  Scene scene("glass");
-  const MaterialId glass = scene.add_material({"glass", {0.5f, 0.8f, 1.0f, 0.3f}, true, 0});
-  const MaterialId grey = scene.add_material({"grey", {0.6f, 0.6f, 0.6f, 1.0f}, false, 0});
-  scene.add_object(scene.add_mesh(test::box_mesh({{-3, -3, -11}, {3, 3, -10}})), glass, glm::mat4(1),
-                   OccluderClass::never);
-  scene.add_object(scene.add_mesh(test::box_mesh({{-1, -1, -21}, {1, 1, -19}})), grey, glm::mat4(1),
-                   OccluderClass::always);
-  scene.add_object(scene.add_mesh(test::box_mesh({{-0.5f, -0.5f, -40}, {0.5f, 0.5f, -39}})), glass,
-                   glm::mat4(1), OccluderClass::never);  // glass behind the grey box: hidden
+  const Scene scene = test::glass_scene();
   gl::RendererOptions o;
   o.width = o.height = 128;
   gl::Renderer r(scene, o);

@@ -190,13 +190,7 @@ TEST_F(RendererTest, ScreenshotHasTheObjectsOverTheBackground) {
 }
 
 TEST_F(RendererTest, TranslucentObjectsNeitherOccludeNorWriteIds) {
-  Scene scene("glass");
-  const MaterialId glass = scene.add_material({"glass", {0.5f, 0.8f, 1.0f, 0.3f}, true, 0});
-  const MaterialId grey = scene.add_material({"grey", {0.6f, 0.6f, 0.6f, 1.0f}, false, 0});
-  scene.add_object(scene.add_mesh(test::box_mesh({{-3, -3, -11}, {3, 3, -10}})), glass, glm::mat4(1),
-                   OccluderClass::never);
-  scene.add_object(scene.add_mesh(test::box_mesh({{-1, -1, -21}, {1, 1, -19}})), grey, glm::mat4(1),
-                   OccluderClass::always);
+  const Scene scene = test::glass_scene();
   const View view = make_view({{0, 0, 0}, 0, 0}, {60.0f, 0.1f, 100.0f}, kSize, kSize);
   gl::Renderer r(scene, small());
   r.begin_frame(view);

@@ -50,6 +50,20 @@ inline Scene box_scene(const std::vector<Aabb>& boxes, OccluderClass cls = Occlu
   return s;
 }
 
+/// Glass pane 10 m down -Z (object 0, translucent), a grey box 20 m down
+/// behind it (1, opaque), and a small glass box 40 m down hidden behind the
+/// grey one (2, translucent).
+inline Scene glass_scene() {
+  Scene s("glass");
+  const MaterialId glass = s.add_material({"glass", {0.5f, 0.8f, 1.0f, 0.3f}, true, 0});
+  const MaterialId grey = s.add_material({"grey", {0.6f, 0.6f, 0.6f, 1.0f}, false, 0});
+  s.add_object(s.add_mesh(box_mesh({{-3, -3, -11}, {3, 3, -10}})), glass, glm::mat4(1), OccluderClass::never);
+  s.add_object(s.add_mesh(box_mesh({{-1, -1, -21}, {1, 1, -19}})), grey, glm::mat4(1), OccluderClass::always);
+  s.add_object(s.add_mesh(box_mesh({{-0.5f, -0.5f, -40}, {0.5f, 0.5f, -39}})), glass, glm::mat4(1),
+               OccluderClass::never);
+  return s;
+}
+
 /// Backend double: records what was rendered and queried; a query's
 /// result comes from `visible_samples(boxes)` (default: 1 sample per box).
 class RecordingBackend final : public Backend {
