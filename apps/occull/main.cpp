@@ -266,7 +266,9 @@ int main(int argc, char** argv) {
   b->add_option("--scene", bench.scene, "scene spec name[:key=value,...] (see occull scenes)")
       ->capture_default_str();
   b->add_option("--path", bench.path, "camera path (default: the scene's first)");
-  b->add_option("--algo", bench.algos, "comma-separated algorithms (default: all; see occull algos)");
+  b->add_option("--algo", bench.algos,
+                "comma-separated algorithms, each optionally with its own options as "
+                "name:key=value:key=value (default: all; see occull algos)");
   b->add_option("--frames", bench.frames, "timed frames per algorithm")->capture_default_str();
   b->add_option("--warmup", bench.warmup, "untimed warm-up frames per algorithm")->capture_default_str();
   b->add_option("--size", bench.size, "render size WIDTHxHEIGHT")->capture_default_str();

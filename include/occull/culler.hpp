@@ -83,6 +83,16 @@ struct AlgorithmInfo {
 /// The named algorithm. Throws InputError listing the valid names.
 [[nodiscard]] const AlgorithmInfo& find_algorithm(std::string_view name);
 
+/// An algorithm with its own options: "name" or "name:key=value:key=value"
+/// (e.g. "chcpp:multiquery=off:batch=20"), so one run can compare variants.
+struct AlgorithmSpec {
+  std::string name;  ///< the algorithm
+  Options options;   ///< `base` with the spec's keys (as "name.key") set over it
+};
+/// Parses a spec. Throws InputError for an unknown algorithm or option, or
+/// an item that is not key=value.
+[[nodiscard]] AlgorithmSpec parse_algorithm_spec(std::string_view spec, const Options& base = {});
+
 /// Checks every key of `options`: its algorithm must exist and know the
 /// option. Throws InputError listing the valid algorithms or options.
 void check_options(const Options& options);

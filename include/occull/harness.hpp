@@ -77,9 +77,11 @@ class Session {
   [[nodiscard]] std::vector<FrameTruth> ground_truth(const CameraPath& path, int frames,
                                                      const ProgressFn& progress = {});
 
-  /// Makes a culler by name for this scene; `oracle` too (it is fed the
-  /// truth by run_path). Throws InputError like make_culler().
-  [[nodiscard]] std::unique_ptr<Culler> make(std::string_view name, const Options& options) const;
+  /// Makes a culler from an algorithm spec ("chcpp" or
+  /// "chcpp:multiquery=off", see parse_algorithm_spec) for this scene;
+  /// `oracle` too (run_path feeds it the truth). Throws InputError like
+  /// make_culler().
+  [[nodiscard]] std::unique_ptr<Culler> make(std::string_view spec, const Options& options) const;
 
   /// Runs `culler` over frames 0..frames-1 of `path`. With `truth` (one
   /// entry per frame), verifies every frame; the oracle needs it.
@@ -111,7 +113,7 @@ class Session {
 struct BenchConfig {
   std::string scene = "city";             ///< scene spec, see make_scene()
   std::string path;                       ///< camera path; empty = the scene's first
-  std::vector<std::string> algorithms;    ///< empty = every algorithm (oracle included)
+  std::vector<std::string> algorithms;    ///< specs (see parse_algorithm_spec); empty = every algorithm
   int frames = 100;                       ///< timed frames per algorithm and repeat, >= 1
   int warmup = 8;                         ///< untimed frames per algorithm and repeat first, >= 0
   int repeat = 1;                         ///< runs of the whole set, interleaved (A B C A B C), >= 1

@@ -25,6 +25,38 @@ const std::vector<Entry>& registry() {
        &detail::make_none},
       {{"vfc", "hierarchical view-frustum culling over the BVH, front to back", true, {}},
        &detail::make_vfc},
+      {{"stopwait", "hierarchical stop-and-wait: query every node in the frustum front to back, wait for each",
+        true,
+        {{"threshold", "0", "a node is visible when more samples (pixels) pass"},
+         {"virtual_leaf", "0", "subtrees with at most this many triangles count as leaves (0: off)"}}},
+       &detail::make_stopwait},
+      {{"perobject", "per-object async queries after an occluder pre-pass; visible objects re-tested every N frames (seed 002)",
+        false,
+        {{"interval", "5", "MAX_FRAMES_WO_OCCLUSION_TESTING: frames a visible object goes untested"},
+         {"render_pending", "on", "draw an object while its query is pending"},
+         {"prepass", "on", "draw occluders (class always) first and never test them"},
+         {"threshold", "0", "an object is visible when more samples (pixels) pass"}}},
+       &detail::make_perobject},
+      {{"chc", "coherent hierarchical culling (Bittner & Wimmer 2004; seed 000 Listing 8.4.1)", true,
+        {{"threshold", "0", "a node is visible when more samples (pixels) pass"},
+         {"skip", "0", "n_av: a visible leaf is assumed visible for n_av frames, queried in frame n_av+1"},
+         {"virtual_leaf", "0", "subtrees with at most this many triangles count as leaves (0: off)"}}},
+       &detail::make_chc},
+      {{"chcpp", "CHC++: batched i/v-queues, render queue, multiqueries, jittered re-queries, tight bounds (seed 000)",
+        true,
+        {{"batch", "50", "b: previously invisible nodes per query batch (1: no batching)"},
+         {"vqueue", "on", "defer queries of visible leaves to fill idle time (off: query each at once)"},
+         {"multiquery", "on", "group previously invisible nodes into multiqueries by p_keep"},
+         {"jitter", "on", "first re-query of a newly visible leaf after a random 0 < r < n_av frames"},
+         {"n_av", "6", "frames between queries of a visible leaf"},
+         {"tight", "on", "query with the descendants' boxes (tighter bounding volumes)"},
+         {"d_max", "3", "tight bounds: levels below the node"},
+         {"s_max", "1.4", "tight bounds: most total surface area, relative to the node's"},
+         {"virtual_leaf", "0", "subtrees with at most this many triangles count as leaves (0: off)"},
+         {"threshold", "0", "a node is visible when more samples (pixels) pass"},
+         {"pkeep_samples", "20", "tests at persistence i before the measured p_keep(i) replaces the formula"},
+         {"seed", "1", "random seed of the jitter"}}},
+       &detail::make_chcpp},
       {{"oracle",
         "renders exactly the ground-truth visible set, no queries: the lower bound (occull bench only)",
         true, {}, true},
@@ -139,6 +171,23 @@ const AlgorithmInfo& find_algorithm(std::string_view name) {
     if (a.name == name) return a;
   throw InputError(
       fmt::format("unknown algorithm '{}'; valid algorithms: {}", name, algorithm_names()));
+}
+
+AlgorithmSpec parse_algorithm_spec(std::string_view spec, const Options& base) {
+  const auto colon = spec.find(':');
+  AlgorithmSpec out{std::string(spec.substr(0, colon)), base};
+  const AlgorithmInfo& info = find_algorithm(out.name);
+  std::string_view rest = colon == std::string_view::npos ? std::string_view{} : spec.substr(colon + 1);
+  while (!rest.empty()) {
+    const auto next = rest.find(':');
+    const std::string_view item = rest.substr(0, next);
+    rest = next == std::string_view::npos ? std::string_view{} : rest.substr(next + 1);
+    if (item.find('=') == std::string_view::npos)
+      throw InputError(fmt::format("algorithm '{}': '{}' is not key=value", spec, item));
+    out.options.set(info.name + "." + std::string(item));
+  }
+  check_options(out.options);
+  return out;
 }
 
 std::unique_ptr<Culler> make_culler(std::string_view name, const SceneIndex& index,

@@ -9,5 +9,9 @@ namespace occull::detail {
 
 std::unique_ptr<Culler> make_none(const SceneIndex& index, const Options& options);
 std::unique_ptr<Culler> make_vfc(const SceneIndex& index, const Options& options);
+std::unique_ptr<Culler> make_stopwait(const SceneIndex& index, const Options& options);
+std::unique_ptr<Culler> make_perobject(const SceneIndex& index, const Options& options);
+std::unique_ptr<Culler> make_chc(const SceneIndex& index, const Options& options);
+std::unique_ptr<Culler> make_chcpp(const SceneIndex& index, const Options& options);
 
 }  // namespace occull::detail

@@ -1,21 +1,119 @@
-// Internal helpers shared by the hierarchical cullers.
+// Internal: pieces shared by the hierarchical cullers — per-node temporal
+// state, the front-to-back distance queue, the eye-inside rule, pull-up of
+// visibility, rendering a node's objects and shaping a node's query.
 #pragma once
 
 #include "occull/bvh.hpp"
+#include "occull/culler.hpp"
 
 #include <array>
+#include <cstdint>
+#include <queue>
+#include <vector>
 
 namespace occull::detail {
 
-/// The two children of interior node `n`, the one nearer to `eye` first
-/// (distance from the eye to each child's box; ties keep left first).
-/// Precondition: n is not a leaf.
-inline std::array<NodeId, 2> children_front_to_back(const Bvh& bvh, NodeId n,
-                                                    const glm::vec3& eye) {
+inline constexpr std::uint32_t kNever = 0xffffffffu;
+
+/// What a coherent culler remembers of a node between frames.
+struct NodeState {
+  std::uint32_t last_visited = kNever;  ///< frame number of the last visit
+  std::uint32_t next_query = 0;         ///< a visible leaf is queried again from this frame on
+  std::uint32_t invisible_tests = 0;    ///< consecutive tests that found it invisible (persistence)
+  bool visible = false;                 ///< classification after its last visit
+};
+
+/// Visible in the previous frame (CHC's WasVisible).
+inline bool was_visible(const NodeState& s, std::uint32_t frame) {
+  return s.visible && s.last_visited != kNever && s.last_visited + 1 == frame;
+}
+
+/// Marks `n` and its ancestors visible, stopping at the first ancestor that
+/// already is (CHC's PullUpVisibility).
+inline void pull_up_visibility(std::vector<NodeState>& state, const Bvh& bvh, NodeId n) {
+  while (n != kNoNode && !state[n].visible) {
+    state[n].visible = true;
+    n = bvh.node(n).parent;
+  }
+}
+
+/// The two children of interior node `n`, the one nearer to `eye` first.
+inline std::array<NodeId, 2> children_front_to_back(const Bvh& bvh, NodeId n, const glm::vec3& eye) {
   const NodeId l = Bvh::left(n);
   const NodeId r = bvh.right(n);
   if (distance(eye, bvh.node(r).bounds) < distance(eye, bvh.node(l).bounds)) return {r, l};
   return {l, r};
 }
+
+/// Traversal queue ordered by distance from the eye to the node's box,
+/// nearest first (ties: lower node id first, so traversal is deterministic).
+class DistanceQueue {
+ public:
+  void push(const Bvh& bvh, NodeId n, const glm::vec3& eye) {
+    heap_.push({distance(eye, bvh.node(n).bounds), n});
+  }
+  NodeId pop() {
+    const NodeId n = heap_.top().node;
+    heap_.pop();
+    return n;
+  }
+  [[nodiscard]] bool empty() const { return heap_.empty(); }
+
+ private:
+  struct Entry {
+    float distance;
+    NodeId node;
+    bool operator>(const Entry& o) const {
+      return distance > o.distance || (distance == o.distance && node > o.node);
+    }
+  };
+  std::priority_queue<Entry, std::vector<Entry>, std::greater<>> heap_;
+};
+
+/// Distance from the eye to the corners of the near-plane rectangle: a box
+/// closer than this to the eye may be cut by the near plane.
+float near_plane_radius(const View& view);
+
+/// The eye-inside rule (DESIGN, seed 002): a box that, grown by the near
+/// plane radius, contains the eye is visible without a query — its query
+/// could miss the faces around the camera, and an object that close is
+/// visible anyway.
+inline bool near_eye(const Aabb& box, const View& view, float radius) {
+  return box.grown(radius).contains(view.eye);
+}
+
+/// Hierarchical frustum culling: appends every object whose box is not
+/// outside the frustum, nearest subtree first (plane masks skip the planes a
+/// node is fully inside). Counts visited nodes in stats.nodes_visited.
+void collect_in_frustum_front_to_back(const SceneIndex& index, const View& view,
+                                      std::vector<ObjectId>& out, FrameStats& stats);
+
+/// Appends the objects of node `n` whose boxes are not outside the frustum.
+void append_objects_in_frustum(const SceneIndex& index, NodeId n, const View& view,
+                               std::vector<ObjectId>& out);
+
+/// How a node's occlusion query is shaped.
+struct QueryShape {
+  bool tight = false;  ///< children's boxes (seed 000 "tighter bounding volumes")
+  int d_max = 3;
+  float s_max = 1.4f;
+};
+
+/// Appends the boxes of node `n`'s query.
+inline void append_query_boxes(const SceneIndex& index, NodeId n, const QueryShape& shape,
+                               std::vector<Aabb>& out) {
+  if (shape.tight)
+    index.bvh.gather_tight_boxes(n, shape.d_max, shape.s_max, index.scene, out);
+  else
+    out.push_back(index.bvh.node(n).bounds);
+}
+
+/// Options every hierarchical query culler shares, read from "<algo>.key".
+struct CommonOptions {
+  std::uint64_t threshold = 0;           ///< a node is visible when more samples pass
+  std::uint32_t virtual_leaf_triangles = 0;
+};
+CommonOptions read_common_options(const Options& options, const std::string& algo,
+                                  std::uint32_t default_virtual_leaf = 0);
 
 }  // namespace occull::detail

@@ -123,9 +123,10 @@ std::vector<FrameTruth> Session::ground_truth(const CameraPath& path, int frames
   return truth;
 }
 
-std::unique_ptr<Culler> Session::make(std::string_view name, const Options& options) const {
-  if (find_algorithm(name).name == "oracle") return std::make_unique<detail::OracleCuller>(bundle_.scene);
-  return make_culler(name, index(), options);
+std::unique_ptr<Culler> Session::make(std::string_view spec, const Options& options) const {
+  const AlgorithmSpec a = parse_algorithm_spec(spec, options);
+  if (a.name == "oracle") return std::make_unique<detail::OracleCuller>(bundle_.scene);
+  return make_culler(a.name, index(), a.options);
 }
 
 AlgorithmRun Session::run_path(std::string_view name, Culler& culler, const CameraPath& path,
@@ -272,7 +273,7 @@ BenchResult run_bench(const BenchConfig& config, const ProgressFn& progress) {
     for (const auto& a : algorithms()) names.push_back(a.name);
   // Validate names and options before the (slow) scene set-up.
   for (const auto& n : names) {
-    if (find_algorithm(n).harness_only && !config.verify)
+    if (find_algorithm(parse_algorithm_spec(n).name).harness_only && !config.verify)
       throw InputError(fmt::format("{} needs ground truth: drop it or turn verification on", n));
   }
   check_options(config.options);

@@ -59,14 +59,16 @@ std::string misses_text(const BenchResult& r, std::uint64_t v) {
 void print_table(const BenchResult& r, std::ostream& out) {
   out << setup_line(r) << "\n";
   out << fmt::format("device: {} | {} | occull {}\n\n", r.device.renderer, r.device.version, r.commit);
-  out << fmt::format("{:<10} {:>8} {:>8} {:>8} {:>8} {:>6} {:>7} {:>8} {:>7} {:>7} {:>10} {:>7} {:>9}\n",
-                     "algorithm", "mean ms", "median", "p95", "max", "vs vfc", "vs orcl", "queries",
+  std::size_t w = 10;
+  for (const AlgorithmSummary& a : r.summaries) w = std::max(w, a.name.size());
+  out << fmt::format("{:<{}} {:>8} {:>8} {:>8} {:>8} {:>6} {:>7} {:>8} {:>7} {:>7} {:>10} {:>7} {:>9}\n",
+                     "algorithm", w, "mean ms", "median", "p95", "max", "vs vfc", "vs orcl", "queries",
                      "states", "draws", "triangles", "missed", "wrong px");
   for (const AlgorithmSummary& a : r.summaries) {
     out << fmt::format(
-        "{:<10} {:>8.2f} {:>8.2f} {:>8.2f} {:>8.2f} {:>6} {:>7} {:>8.1f} {:>7.1f} {:>7.0f} {:>10.0f} "
+        "{:<{}} {:>8.2f} {:>8.2f} {:>8.2f} {:>8.2f} {:>6} {:>7} {:>8.1f} {:>7.1f} {:>7.0f} {:>10.0f} "
         "{:>7} {:>9}\n",
-        a.name, a.frame_ms.mean, a.frame_ms.median, a.frame_ms.p95, a.frame_ms.max,
+        a.name, w, a.frame_ms.mean, a.frame_ms.median, a.frame_ms.p95, a.frame_ms.max,
         ratio_text(a.ratio_to_vfc), ratio_text(a.ratio_to_oracle), a.queries_per_frame,
         a.state_changes_per_frame, a.draw_calls_per_frame, a.triangles_per_frame,
         misses_text(r, a.missed_objects), misses_text(r, a.wrong_pixels));

@@ -1,0 +1,135 @@
+// `chc`: coherent hierarchical culling (Bittner & Wimmer 2004; seed 000,
+// Listing 8.4.1).
+//
+// Front-to-back traversal that queries only previously invisible nodes and
+// previously visible leaves. Previously visible leaves are rendered at once
+// without waiting (their query only updates the classification for the next
+// frame: the one-frame delay of visible-to-invisible changes); previously
+// invisible nodes are assumed invisible until their query comes back, and
+// the traversal goes on with other nodes meanwhile. Visibility is pulled up
+// to the ancestors. Each query and each rendered leaf is its own backend
+// call, interleaved — the state changes CHC++ later removes.
+//
+// Options: threshold (pixels), skip (n_av: a visible leaf is assumed to
+// stay visible for n_av frames and queried again in frame n_av + 1),
+// virtual_leaf (triangles).
+#include "cullers.hpp"
+#include "traversal.hpp"
+
+#include <deque>
+
+namespace occull::detail {
+namespace {
+
+class ChcCuller final : public Culler {
+ public:
+  ChcCuller(const SceneIndex& index, const Options& options)
+      : index_(index),
+        common_(read_common_options(options, "chc")),
+        skip_(std::uint32_t(options.get_int("chc.skip", 0, 0, 1000))),
+        state_(index.bvh.size()) {}
+
+  FrameStats render_frame(const View& view, Backend& backend) override {
+    ++frame_;
+    if (state_.size() != index_.bvh.size()) state_.assign(index_.bvh.size(), NodeState{});
+    stats_ = {};
+    view_ = &view;
+    backend_ = &backend;
+    radius_ = near_plane_radius(view);
+
+    queue_.push(index_.bvh, Bvh::root(), view.eye);
+    while (!queue_.empty() || !queries_.empty()) {
+      // Handle returned queries; when there is nothing else to do, wait.
+      while (!queries_.empty() && (queue_.empty() || backend.result_available(queries_.front().id))) {
+        const Pending p = queries_.front();
+        queries_.pop_front();
+        handle_returned_query(p, backend.result(p.id));
+      }
+      if (queue_.empty()) continue;
+      const NodeId n = queue_.pop();
+      ++stats_.nodes_visited;
+      NodeState& s = state_[n];
+      const bool previously_visible = was_visible(s, frame_);
+      s.visible = false;  // invisible until shown otherwise
+      s.last_visited = frame_;
+      const BvhNode& node = index_.bvh.node(n);
+      if (node.object_count == 0 || view.frustum.classify(node.bounds) == Containment::outside)
+        continue;
+      if (near_eye(node.bounds, view, radius_)) {
+        pull_up_visibility(state_, index_.bvh, n);
+        traverse(n);
+        continue;
+      }
+      if (!previously_visible) {
+        query(n, false);  // the previously invisible boundary
+      } else {
+        if (is_leaf(n)) {
+          if (frame_ >= s.next_query)
+            query(n, true);  // result only updates the next frame
+          else
+            pull_up_visibility(state_, index_.bvh, n);
+        }
+        traverse(n);
+      }
+    }
+    return stats_;
+  }
+
+ private:
+  struct Pending {
+    QueryId id;
+    NodeId node;
+    bool previously_visible;
+  };
+
+  bool is_leaf(NodeId n) const { return index_.bvh.is_leaf(n, common_.virtual_leaf_triangles); }
+
+  void query(NodeId n, bool previously_visible) {
+    boxes_.clear();
+    append_query_boxes(index_, n, {}, boxes_);
+    queries_.push_back({backend_->issue_query(boxes_), n, previously_visible});
+    ++stats_.query_batches;
+  }
+
+  void handle_returned_query(const Pending& p, std::uint64_t samples) {
+    if (samples <= common_.threshold) return;  // stays invisible
+    if (!p.previously_visible) traverse(p.node);  // turned visible: process it now
+    pull_up_visibility(state_, index_.bvh, p.node);
+    if (is_leaf(p.node)) state_[p.node].next_query = frame_ + skip_ + 1;
+  }
+
+  void traverse(NodeId n) {
+    if (is_leaf(n)) {
+      objects_.clear();
+      append_objects_in_frustum(index_, n, *view_, objects_);
+      if (!objects_.empty()) backend_->render(objects_);
+    } else {
+      queue_.push(index_.bvh, Bvh::left(n), view_->eye);
+      queue_.push(index_.bvh, index_.bvh.right(n), view_->eye);
+    }
+  }
+
+  SceneIndex index_;
+  CommonOptions common_;
+  std::uint32_t skip_;
+  std::vector<NodeState> state_;
+  std::uint32_t frame_ = 0;
+
+  // Per frame.
+  FrameStats stats_;
+  const View* view_ = nullptr;
+  Backend* backend_ = nullptr;
+  float radius_ = 0.0f;
+  DistanceQueue queue_;
+  std::deque<Pending> queries_;
+  std::vector<Aabb> boxes_;
+  std::vector<ObjectId> objects_;
+};
+
+}  // namespace
+
+std::unique_ptr<Culler> make_chc(const SceneIndex& index, const Options& options) {
+  return std::make_unique<ChcCuller>(index, options);
+}
+
+}  // namespace occull::detail

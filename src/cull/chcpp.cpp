@@ -1,0 +1,318 @@
+// `chcpp`: CHC++ (Mattausch, Bittner, Wimmer 2008; seed 000, Listing 8.4.2).
+//
+// CHC with the game-engine-friendly changes of the article:
+//   - i-queue: previously invisible nodes are queried in batches of `batch`
+//     nodes (one render/query state change per batch);
+//   - v-queue: queries of previously visible leaves wait in a queue, fill
+//     idle time while results are outstanding, and go out as one batch at
+//     the end of the frame;
+//   - render queue: nodes to render are collected and handed to the engine
+//     (Backend::render, which sorts by material) just before a query batch;
+//   - multiqueries: i-queue nodes sorted by p_keep — the learned probability
+//     that a node invisible for i tests stays invisible — are grouped
+//     greedily where V = |M| / (1 + p_fail(M) |M|) peaks; a group that comes
+//     back visible is re-queried node by node;
+//   - jittered re-queries: a newly visible leaf is first re-queried after a
+//     random 0 < r < n_av frames, then every n_av frames;
+//   - tight bounding volumes: a node is queried with its descendants' boxes
+//     down to d_max levels within s_max times its surface area, and small
+//     subtrees are virtual leaves.
+// Every feature has an option to switch it off, so its effect can be measured.
+#include "chcpp.hpp"
+
+#include "cullers.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <deque>
+
+namespace occull::detail {
+
+// ---- p_keep: visibility persistence statistics ---------------------------
+
+double VisibilityPersistence::analytic(std::uint32_t i) {
+  return 0.99 - 0.7 * std::exp(-double(i));
+}
+
+void VisibilityPersistence::record(std::uint32_t i, bool kept) {
+  i = std::min<std::uint32_t>(i, kMaxPersistence);
+  ++all_[i];
+  if (kept) ++keep_[i];
+}
+
+double VisibilityPersistence::p_keep(std::uint32_t i) const {
+  i = std::min<std::uint32_t>(i, kMaxPersistence);
+  // Measured where there are enough samples; otherwise the nearest lower i
+  // that has them (piecewise-constant propagation); otherwise the formula.
+  for (std::uint32_t j = i + 1; j-- > 0;)
+    if (all_[j] >= min_samples_) return double(keep_[j]) / double(all_[j]);
+  return analytic(i);
+}
+
+// ---- multiquery grouping -------------------------------------------------
+
+std::size_t best_multiquery_size(std::span<const double> p_keep_sorted) {
+  double keep_all = 1.0;
+  double best_value = 0.0;
+  std::size_t best = 1;
+  for (std::size_t j = 0; j < p_keep_sorted.size(); ++j) {
+    keep_all *= p_keep_sorted[j];
+    const double size = double(j + 1);
+    const double value = size / (1.0 + (1.0 - keep_all) * size);  // B(M) / C(M)
+    if (value > best_value) {
+      best_value = value;
+      best = j + 1;
+    }
+  }
+  return best;
+}
+
+std::uint32_t first_requery_delay(std::uint32_t n_av, std::uint64_t random) {
+  if (n_av <= 1) return n_av;
+  return 1 + std::uint32_t(random % (n_av - 1));  // 0 < r < n_av
+}
+
+namespace {
+
+ChcppConfig read_config(const Options& o) {
+  ChcppConfig c;
+  c.batch = std::uint32_t(o.get_int("chcpp.batch", int(c.batch), 1, 100000));
+  c.v_queue = o.get_bool("chcpp.vqueue", c.v_queue);
+  c.multiquery = o.get_bool("chcpp.multiquery", c.multiquery);
+  c.jitter = o.get_bool("chcpp.jitter", c.jitter);
+  c.n_av = std::uint32_t(o.get_int("chcpp.n_av", int(c.n_av), 1, 1000));
+  c.shape.tight = o.get_bool("chcpp.tight", c.shape.tight);
+  c.shape.d_max = o.get_int("chcpp.d_max", c.shape.d_max, 0, 16);
+  c.shape.s_max = float(o.get_double("chcpp.s_max", c.shape.s_max, 1.0, 100.0));
+  c.common = read_common_options(o, "chcpp", c.common.virtual_leaf_triangles);
+  c.pkeep_min_samples = std::uint32_t(o.get_int("chcpp.pkeep_samples", int(c.pkeep_min_samples), 1, 1 << 24));
+  c.seed = std::uint64_t(o.get_int("chcpp.seed", int(c.seed), 0, 1 << 30));
+  return c;
+}
+
+// SplitMix64, for the jitter: deterministic for a given seed.
+std::uint64_t next_random(std::uint64_t& state) {
+  std::uint64_t z = (state += 0x9E3779B97F4A7C15ull);
+  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+  z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+  return z ^ (z >> 31);
+}
+
+class ChcppCuller final : public Culler {
+ public:
+  ChcppCuller(const SceneIndex& index, const ChcppConfig& config)
+      : index_(index), config_(config), persistence_(config.pkeep_min_samples),
+        state_(index.bvh.size()), random_(config.seed) {}
+
+  FrameStats render_frame(const View& view, Backend& backend) override {
+    ++frame_;
+    if (state_.size() != index_.bvh.size()) state_.assign(index_.bvh.size(), NodeState{});
+    stats_ = {};
+    view_ = &view;
+    backend_ = &backend;
+    radius_ = near_plane_radius(view);
+
+    distance_queue_.push(index_.bvh, Bvh::root(), view.eye);
+    while (!distance_queue_.empty() || !query_queue_.empty() || !i_queue_.empty()) {
+      while (!query_queue_.empty()) {
+        const bool available = backend.result_available(query_queue_.front().id);
+        if (!available && !distance_queue_.empty()) break;  // go on traversing
+        if (available)
+          handle_returned_query();
+        else if (!v_queue_.empty())
+          issue_v_query();  // fill the idle time
+        else
+          handle_returned_query();  // nothing else to do: wait
+      }
+      if (!distance_queue_.empty()) process_node(distance_queue_.pop());
+      if (distance_queue_.empty()) issue_multiqueries();
+    }
+    // One last batch for the visible leaves not queried yet, then their results.
+    if (!v_queue_.empty()) {
+      flush_render_queue();
+      ++stats_.query_batches;
+      while (!v_queue_.empty()) {
+        const NodeId n = v_queue_.front();
+        v_queue_.pop_front();
+        issue({n}, true);
+      }
+    }
+    flush_render_queue();
+    while (!query_queue_.empty()) handle_returned_query();
+    return stats_;
+  }
+
+ private:
+  struct Pending {
+    QueryId id;
+    std::vector<NodeId> nodes;  // > 1: a multiquery
+    bool previously_visible;
+  };
+  struct Invisible {
+    NodeId node;
+    bool single;  // re-queried alone after a failed multiquery
+  };
+
+  bool is_leaf(NodeId n) const { return index_.bvh.is_leaf(n, config_.common.virtual_leaf_triangles); }
+
+  void process_node(NodeId n) {
+    ++stats_.nodes_visited;
+    NodeState& s = state_[n];
+    const bool previously_visible = was_visible(s, frame_);
+    s.visible = false;  // invisible by default
+    s.last_visited = frame_;
+    if (previously_visible) s.invisible_tests = 0;  // if invisible now, its persistence starts over
+    const BvhNode& node = index_.bvh.node(n);
+    if (node.object_count == 0 || view_->frustum.classify(node.bounds) == Containment::outside)
+      return;
+    if (near_eye(node.bounds, *view_, radius_)) {
+      pull_up_visibility(state_, index_.bvh, n);
+      traverse(n);
+      return;
+    }
+    if (!previously_visible) {
+      i_queue_.push_back({n, false});
+      if (i_queue_.size() >= config_.batch) issue_multiqueries();
+      return;
+    }
+    if (is_leaf(n)) {
+      if (frame_ >= s.next_query) {
+        if (config_.v_queue) {
+          v_queue_.push_back(n);
+        } else {
+          flush_render_queue();  // CHC order: query the leaf, then render it
+          ++stats_.query_batches;
+          issue({n}, true);
+        }
+      } else {
+        pull_up_visibility(state_, index_.bvh, n);
+      }
+    }
+    traverse(n);
+  }
+
+  void traverse(NodeId n) {
+    if (is_leaf(n)) {
+      append_objects_in_frustum(index_, n, *view_, render_queue_);
+    } else {
+      distance_queue_.push(index_.bvh, Bvh::left(n), view_->eye);
+      distance_queue_.push(index_.bvh, index_.bvh.right(n), view_->eye);
+    }
+  }
+
+  void flush_render_queue() {
+    if (render_queue_.empty()) return;
+    backend_->render(render_queue_);
+    render_queue_.clear();
+  }
+
+  void issue(std::vector<NodeId> nodes, bool previously_visible) {
+    boxes_.clear();
+    for (NodeId n : nodes) append_query_boxes(index_, n, config_.shape, boxes_);
+    if (nodes.size() > 1) ++stats_.multiqueries;
+    query_queue_.push_back({backend_->issue_query(boxes_), std::move(nodes), previously_visible});
+  }
+
+  void issue_v_query() {
+    flush_render_queue();
+    ++stats_.query_batches;
+    const NodeId n = v_queue_.front();
+    v_queue_.pop_front();
+    issue({n}, true);
+  }
+
+  // Issues the i-queue as one batch: multiqueries grouped by p_keep, or
+  // one query per node.
+  void issue_multiqueries() {
+    if (i_queue_.empty()) return;
+    flush_render_queue();
+    ++stats_.query_batches;
+    std::vector<Invisible> grouped;
+    for (const Invisible& e : i_queue_) {
+      if (e.single || !config_.multiquery)
+        issue({e.node}, false);
+      else
+        grouped.push_back(e);
+    }
+    i_queue_.clear();
+    if (grouped.empty()) return;
+    // Most likely to stay invisible first.
+    std::vector<std::pair<double, NodeId>> order;
+    order.reserve(grouped.size());
+    for (const Invisible& e : grouped)
+      order.emplace_back(persistence_.p_keep(state_[e.node].invisible_tests), e.node);
+    std::stable_sort(order.begin(), order.end(),
+                     [](const auto& a, const auto& b) { return a.first > b.first; });
+    std::vector<double> p(order.size());
+    for (std::size_t i = 0; i < order.size(); ++i) p[i] = order[i].first;
+    for (std::size_t begin = 0; begin < order.size();) {
+      const std::size_t size = best_multiquery_size(std::span<const double>(p).subspan(begin));
+      std::vector<NodeId> nodes;
+      for (std::size_t i = begin; i < begin + size; ++i) nodes.push_back(order[i].second);
+      issue(std::move(nodes), false);
+      begin += size;
+    }
+  }
+
+  void handle_returned_query() {
+    Pending q = std::move(query_queue_.front());
+    query_queue_.pop_front();
+    const bool visible = backend_->result(q.id) > config_.common.threshold;
+    if (q.previously_visible) {  // a v-queue query: classification for the next frame
+      const NodeId n = q.nodes.front();
+      if (visible) {
+        pull_up_visibility(state_, index_.bvh, n);
+        state_[n].next_query = frame_ + config_.n_av;
+      } else {
+        state_[n].invisible_tests = 0;  // newly invisible
+      }
+      return;
+    }
+    if (visible && q.nodes.size() > 1) {  // failed multiquery: query each node alone
+      ++stats_.failed_multiqueries;
+      for (NodeId n : q.nodes) i_queue_.push_back({n, true});
+      return;
+    }
+    for (NodeId n : q.nodes) {
+      NodeState& s = state_[n];
+      persistence_.record(s.invisible_tests, !visible);
+      if (!visible) {
+        ++s.invisible_tests;
+        continue;
+      }
+      s.invisible_tests = 0;
+      traverse(n);  // turned visible: process it now
+      pull_up_visibility(state_, index_.bvh, n);
+      if (is_leaf(n))
+        s.next_query = frame_ + (config_.jitter ? first_requery_delay(config_.n_av, next_random(random_))
+                                                : config_.n_av);
+    }
+  }
+
+  SceneIndex index_;
+  ChcppConfig config_;
+  VisibilityPersistence persistence_;
+  std::vector<NodeState> state_;
+  std::uint32_t frame_ = 0;
+  std::uint64_t random_;
+
+  // Per frame.
+  FrameStats stats_;
+  const View* view_ = nullptr;
+  Backend* backend_ = nullptr;
+  float radius_ = 0.0f;
+  DistanceQueue distance_queue_;
+  std::deque<Pending> query_queue_;
+  std::vector<Invisible> i_queue_;
+  std::deque<NodeId> v_queue_;
+  std::vector<ObjectId> render_queue_;
+  std::vector<Aabb> boxes_;
+};
+
+}  // namespace
+
+std::unique_ptr<Culler> make_chcpp(const SceneIndex& index, const Options& options) {
+  return std::make_unique<ChcppCuller>(index, read_config(options));
+}
+
+}  // namespace occull::detail

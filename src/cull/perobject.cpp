@@ -1,0 +1,125 @@
+// `perobject`: per-object asynchronous occlusion queries, after the engine
+// notes' "Simple Pseudo-code" (seed 002).
+//
+// Objects in the frustum are taken nearest first. Occluders (occluder class
+// `always`, opaque) are drawn first as a pre-pass. Every other object is an
+// occludee with three pieces of state: frames since its last test, whether a
+// query is running, and how long it has been waiting. A visible occludee is
+// re-tested every `interval` frames (MAX_FRAMES_WO_OCCLUSION_TESTING) and
+// drawn in between; an occluded one is re-tested every frame. A running
+// query is read only when its result is available — often a frame later, so
+// the answer is about an older frame: this culler may pop, and the verifier
+// measures how much. While a query is pending the occludee is drawn or not
+// (`render_pending`, as the notes leave it open). Occludees closer to the
+// eye than the near-plane radius are drawn without a test.
+#include "cullers.hpp"
+#include "traversal.hpp"
+
+namespace occull::detail {
+namespace {
+
+class PerObjectCuller final : public Culler {
+ public:
+  PerObjectCuller(const SceneIndex& index, const Options& o)
+      : index_(index),
+        interval_(std::uint32_t(o.get_int("perobject.interval", 5, 1, 1000))),
+        render_pending_(o.get_bool("perobject.render_pending", true)),
+        prepass_(o.get_bool("perobject.prepass", true)),
+        threshold_(std::uint64_t(o.get_int("perobject.threshold", 0, 0, 1 << 24))),
+        state_(index.scene.objects().size()) {
+    for (State& s : state_) s.frames_without_test = interval_;
+  }
+
+  FrameStats render_frame(const View& view, Backend& backend) override {
+    FrameStats stats;
+    ++frame_;
+    in_frustum_.clear();
+    collect_in_frustum_front_to_back(index_, view, in_frustum_, stats);
+    const float radius = near_plane_radius(view);
+
+    // Pre-pass: the occluders, nearest first.
+    std::vector<ObjectId> occluders;
+    occludees_.clear();
+    for (ObjectId id : in_frustum_) {
+      state_[id].seen = frame_;
+      (is_occluder(id) ? occluders : occludees_).push_back(id);
+    }
+    if (!occluders.empty()) backend.render(occluders);
+
+    const auto draw = [&](ObjectId id) { backend.render(std::span<const ObjectId>(&id, 1)); };
+    for (ObjectId id : occludees_) {
+      State& s = state_[id];
+      const Aabb& box = index_.scene.object(id).bounds;
+      if (!s.started && near_eye(box, view, radius)) {  // too near to test: visible
+        draw(id);
+        continue;
+      }
+      if (s.frames_without_test >= interval_) {
+        if (!s.started) {
+          s.query = backend.issue_query(std::span<const Aabb>(&box, 1));
+          s.started = true;
+          ++stats.query_batches;
+        }
+      } else {
+        ++s.frames_without_test;
+        draw(id);
+      }
+      if (s.started) {
+        if (!backend.result_available(s.query)) {
+          if (render_pending_) draw(id);
+        } else {
+          s.started = false;
+          if (backend.result(s.query) > threshold_) {
+            draw(id);
+            s.frames_without_test = 0;
+          } else {
+            s.frames_without_test = interval_;  // occluded now: test again next frame
+          }
+        }
+      }
+    }
+    // Queries of objects that left the frustum: collect them when done.
+    for (ObjectId id = 0; id < state_.size(); ++id) {
+      State& s = state_[id];
+      if (s.started && s.seen != frame_ && backend.result_available(s.query)) {
+        (void)backend.result(s.query);
+        s.started = false;
+        s.frames_without_test = interval_;
+      }
+    }
+    return stats;
+  }
+
+  ~PerObjectCuller() override = default;
+
+ private:
+  struct State {
+    std::uint32_t frames_without_test = 0;
+    bool started = false;
+    QueryId query = 0;
+    std::uint32_t seen = 0;  // last frame in the frustum
+  };
+
+  bool is_occluder(ObjectId id) const {
+    const Object& o = index_.scene.object(id);
+    return prepass_ && o.occluder == OccluderClass::always &&
+           !index_.scene.material(o.material).translucent;
+  }
+
+  SceneIndex index_;
+  std::uint32_t interval_;
+  bool render_pending_;
+  bool prepass_;
+  std::uint64_t threshold_;
+  std::vector<State> state_;
+  std::uint32_t frame_ = 0;
+  std::vector<ObjectId> in_frustum_, occludees_;
+};
+
+}  // namespace
+
+std::unique_ptr<Culler> make_perobject(const SceneIndex& index, const Options& options) {
+  return std::make_unique<PerObjectCuller>(index, options);
+}
+
+}  // namespace occull::detail

@@ -1,0 +1,61 @@
+// `stopwait`: hierarchical stop-and-wait occlusion culling — the baseline
+// the CHC papers beat. The BVH is traversed front to back; every node in
+// the frustum is queried and the traversal waits for the answer before it
+// goes on. Visible leaves are rendered at once, so later queries test
+// against everything nearer. No temporal coherence, no batching.
+#include "cullers.hpp"
+#include "traversal.hpp"
+
+namespace occull::detail {
+namespace {
+
+class StopWaitCuller final : public Culler {
+ public:
+  StopWaitCuller(const SceneIndex& index, const Options& options)
+      : index_(index), common_(read_common_options(options, "stopwait")) {}
+
+  FrameStats render_frame(const View& view, Backend& backend) override {
+    FrameStats stats;
+    const Bvh& bvh = index_.bvh;
+    const float radius = near_plane_radius(view);
+    DistanceQueue queue;
+    queue.push(bvh, Bvh::root(), view.eye);
+    while (!queue.empty()) {
+      const NodeId n = queue.pop();
+      ++stats.nodes_visited;
+      const BvhNode& node = bvh.node(n);
+      if (node.object_count == 0 || view.frustum.classify(node.bounds) == Containment::outside)
+        continue;
+      if (!near_eye(node.bounds, view, radius)) {
+        boxes_.clear();
+        append_query_boxes(index_, n, {}, boxes_);
+        const QueryId q = backend.issue_query(boxes_);
+        ++stats.query_batches;
+        if (backend.result(q) <= common_.threshold) continue;  // stop and wait
+      }
+      if (bvh.is_leaf(n, common_.virtual_leaf_triangles)) {
+        objects_.clear();
+        append_objects_in_frustum(index_, n, view, objects_);
+        if (!objects_.empty()) backend.render(objects_);
+      } else {
+        queue.push(bvh, Bvh::left(n), view.eye);
+        queue.push(bvh, bvh.right(n), view.eye);
+      }
+    }
+    return stats;
+  }
+
+ private:
+  SceneIndex index_;
+  CommonOptions common_;
+  std::vector<Aabb> boxes_;
+  std::vector<ObjectId> objects_;
+};
+
+}  // namespace
+
+std::unique_ptr<Culler> make_stopwait(const SceneIndex& index, const Options& options) {
+  return std::make_unique<StopWaitCuller>(index, options);
+}
+
+}  // namespace occull::detail

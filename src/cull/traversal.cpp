@@ -1,0 +1,56 @@
+#include "traversal.hpp"
+
+#include <cmath>
+
+namespace occull::detail {
+
+float near_plane_radius(const View& view) {
+  // proj[0][0] = 1 / (aspect * tan(fov/2)), proj[1][1] = 1 / tan(fov/2).
+  const float half_w = view.near / view.proj[0][0];
+  const float half_h = view.near / view.proj[1][1];
+  return std::sqrt(view.near * view.near + half_w * half_w + half_h * half_h);
+}
+
+void append_objects_in_frustum(const SceneIndex& index, NodeId n, const View& view,
+                               std::vector<ObjectId>& out) {
+  for (ObjectId id : index.bvh.objects(n))
+    if (view.frustum.classify(index.scene.object(id).bounds) != Containment::outside) out.push_back(id);
+}
+
+namespace {
+
+void collect(const SceneIndex& index, NodeId n, std::uint32_t planes, const View& view,
+             std::vector<ObjectId>& out, FrameStats& stats) {
+  const Bvh& bvh = index.bvh;
+  ++stats.nodes_visited;
+  if (bvh.node(n).object_count == 0) return;
+  if (planes != 0 && view.frustum.classify(bvh.node(n).bounds, planes) == Containment::outside)
+    return;
+  if (bvh.is_leaf(n)) {
+    for (ObjectId id : bvh.objects(n)) {
+      std::uint32_t mask = planes;
+      if (planes == 0 || view.frustum.classify(index.scene.object(id).bounds, mask) != Containment::outside)
+        out.push_back(id);
+    }
+    return;
+  }
+  for (NodeId c : children_front_to_back(bvh, n, view.eye)) collect(index, c, planes, view, out, stats);
+}
+
+}  // namespace
+
+void collect_in_frustum_front_to_back(const SceneIndex& index, const View& view,
+                                      std::vector<ObjectId>& out, FrameStats& stats) {
+  collect(index, Bvh::root(), Frustum::all_planes, view, out, stats);
+}
+
+CommonOptions read_common_options(const Options& options, const std::string& algo,
+                                  std::uint32_t default_virtual_leaf) {
+  CommonOptions c;
+  c.threshold = std::uint64_t(options.get_int(algo + ".threshold", 0, 0, 1 << 24));
+  c.virtual_leaf_triangles = std::uint32_t(
+      options.get_int(algo + ".virtual_leaf", int(default_virtual_leaf), 0, 1 << 30));
+  return c;
+}
+
+}  // namespace occull::detail
