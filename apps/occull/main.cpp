@@ -132,6 +132,7 @@ struct BenchArgs {
   std::vector<std::string> opts;
   std::string query_mode = "samples";
   std::string draw = "single";
+  int bvh_leaf = occull::BvhOptions{}.max_leaf_objects;
   int repeat = 1;
   std::string verify = "on";
   std::string json;
@@ -185,6 +186,9 @@ int cmd_bench(const BenchArgs& a) {
   c.query_mode = parse_query_mode(a.query_mode);
   c.multi_draw = parse_draw_mode(a.draw);
   c.repeat = a.repeat;
+  if (a.bvh_leaf < 1 || a.bvh_leaf > 64)
+    throw occull::InputError(fmt::format("--bvh-leaf {}: must be in [1, 64]", a.bvh_leaf));
+  c.bvh.max_leaf_objects = a.bvh_leaf;
   c.verify = parse_on_off("--verify", a.verify);
   const bool report = !a.no_report && !a.report.empty();
   const auto json = open_output(a.json);
@@ -284,6 +288,8 @@ int main(int argc, char** argv) {
   b->add_option("--report", bench.report, "write report.md, SVG charts, JSON and CSV into this folder")
       ->capture_default_str();
   b->add_flag("--no-report", bench.no_report, "do not write the report folder");
+  b->add_option("--bvh-leaf", bench.bvh_leaf, "most objects in a BVH leaf (binned SAH decides below that)")
+      ->capture_default_str();
   b->add_option("--draw", bench.draw,
                 "object submission: single (one draw per object) or multi (one multi-draw per material run)")
       ->capture_default_str();

@@ -28,6 +28,7 @@ struct BackendStats {
   std::uint64_t query_boxes = 0;       ///< boxes drawn inside those queries
   std::uint64_t state_changes = 0;     ///< switches between rendering and querying state
   std::uint64_t material_changes = 0;  ///< material binds while rendering
+  std::uint64_t blocking_waits = 0;    ///< result() calls that had to wait (not available yet)
   double wait_ms = 0.0;                ///< wall time blocked inside result(), milliseconds
   double backend_ms = 0.0;             ///< wall time inside any Backend call, milliseconds
 
@@ -36,6 +37,7 @@ struct BackendStats {
             a.objects_rendered - b.objects_rendered, a.render_flushes - b.render_flushes,
             a.queries - b.queries,             a.query_boxes - b.query_boxes,
             a.state_changes - b.state_changes, a.material_changes - b.material_changes,
+            a.blocking_waits - b.blocking_waits,
             a.wait_ms - b.wait_ms,             a.backend_ms - b.backend_ms};
   }
 };

@@ -63,7 +63,8 @@ class Session {
  public:
   /// Builds the scene from `scene_spec` (throws InputError) and its BVH,
   /// then creates the GL context (throws GlUnavailable) and the renderer.
-  Session(std::string_view scene_spec, const gl::RendererOptions& renderer_options);
+  Session(std::string_view scene_spec, const gl::RendererOptions& renderer_options,
+          const BvhOptions& bvh_options = {});
   ~Session();
   Session(const Session&) = delete;
   Session& operator=(const Session&) = delete;
@@ -123,6 +124,7 @@ struct BenchConfig {
   Options options;
   gl::QueryMode query_mode = gl::QueryMode::samples_passed;
   bool multi_draw = false;                ///< see gl::RendererOptions::multi_draw
+  BvhOptions bvh;                         ///< how the scene's hierarchy is built
 };
 
 /// Mean, median, 95th percentile and maximum of a sample (all 0 when empty).
@@ -152,6 +154,7 @@ struct AlgorithmSummary {
   double nodes_visited_per_frame = 0.0;
   double extra_objects_per_frame = 0.0;  ///< over-rendering (verified runs)
   double wait_ms_per_frame = 0.0;
+  double blocking_waits_per_frame = 0.0;  ///< query reads that had to wait (sync points)
   double cpu_ms_per_frame = 0.0;
   double gpu_ms_per_frame = 0.0;
   std::uint64_t missed_objects = 0;       ///< sum over frames of objects missed

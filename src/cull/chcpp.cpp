@@ -52,8 +52,10 @@ double VisibilityPersistence::p_keep(std::uint32_t i) const {
 // ---- multiquery grouping -------------------------------------------------
 
 std::size_t best_multiquery_size(std::span<const double> p_keep_sorted) {
+  // One query per node has V = 1 (benefit 1 at cost 1 each): a group must
+  // beat that to be worth its risk, so the search starts from there.
   double keep_all = 1.0;
-  double best_value = 0.0;
+  double best_value = 1.0;
   std::size_t best = 1;
   for (std::size_t j = 0; j < p_keep_sorted.size(); ++j) {
     keep_all *= p_keep_sorted[j];
@@ -86,6 +88,9 @@ ChcppConfig read_config(const Options& o) {
   c.shape.s_max = float(o.get_double("chcpp.s_max", c.shape.s_max, 1.0, 100.0));
   c.common = read_common_options(o, "chcpp", c.common.virtual_leaf_triangles);
   c.pkeep_min_samples = std::uint32_t(o.get_int("chcpp.pkeep_samples", int(c.pkeep_min_samples), 1, 1 << 24));
+  c.flush_batches = o.get_bool("chcpp.flush", c.flush_batches);
+  c.render_batch_triangles =
+      std::uint64_t(o.get_int("chcpp.render_batch", int(c.render_batch_triangles), 0, 1 << 30));
   c.seed = std::uint64_t(o.get_int("chcpp.seed", int(c.seed), 0, 1 << 30));
   return c;
 }
@@ -194,6 +199,11 @@ class ChcppCuller final : public Culler {
   void traverse(NodeId n) {
     if (is_leaf(n)) {
       append_objects_in_frustum(index_, n, *view_, render_queue_);
+      render_queue_triangles_ += index_.bvh.node(n).triangles;
+      if (config_.render_batch_triangles > 0 && render_queue_triangles_ >= config_.render_batch_triangles) {
+        flush_render_queue();
+        if (config_.flush_batches) backend_->flush();
+      }
     } else {
       distance_queue_.push(index_.bvh, Bvh::left(n), view_->eye);
       distance_queue_.push(index_.bvh, index_.bvh.right(n), view_->eye);
@@ -204,6 +214,7 @@ class ChcppCuller final : public Culler {
     if (render_queue_.empty()) return;
     backend_->render(render_queue_);
     render_queue_.clear();
+    render_queue_triangles_ = 0;
   }
 
   void issue(std::vector<NodeId> nodes, bool previously_visible) {
@@ -252,6 +263,7 @@ class ChcppCuller final : public Culler {
       issue(std::move(nodes), false);
       begin += size;
     }
+    if (config_.flush_batches) backend_->flush();
   }
 
   void handle_returned_query() {
@@ -306,6 +318,7 @@ class ChcppCuller final : public Culler {
   std::vector<Invisible> i_queue_;
   std::deque<NodeId> v_queue_;
   std::vector<ObjectId> render_queue_;
+  std::uint64_t render_queue_triangles_ = 0;
   std::vector<Aabb> boxes_;
 };
 

@@ -18,9 +18,11 @@ struct ChcppConfig {
   bool jitter = true;             ///< randomise the first re-query of a newly visible leaf
   std::uint32_t n_av = 6;         ///< frames between queries of a visible leaf
   QueryShape shape{true, 3, 1.4f};
-  CommonOptions common{0, 0};
+  CommonOptions common{0, 1500};  ///< threshold 0; virtual leaves up to 1500 triangles
   std::uint32_t pkeep_min_samples = 20;  ///< tests at one i before the measured p_keep(i) is used
   std::uint64_t seed = 1;                ///< of the jitter
+  bool flush_batches = true;             ///< Backend::flush() after each query batch
+  std::uint64_t render_batch_triangles = 20000;  ///< hand the render queue over at this size (0: only before queries)
 };
 
 /// p_keep(i): the probability that a node found invisible in i consecutive
@@ -45,7 +47,9 @@ class VisibilityPersistence {
 };
 
 /// Size j of the multiquery made of the first j nodes (sorted by p_keep,
-/// descending) that maximises V = j / (1 + (1 - prod p_keep) j).
+/// descending) that maximises V = j / (1 + (1 - prod p_keep) j) — or 1 when
+/// no group beats V = 1, the value of querying each node alone (for
+/// hopeless nodes V only creeps towards 1 as the group grows).
 /// Precondition: non-empty.
 std::size_t best_multiquery_size(std::span<const double> p_keep_sorted);
 

@@ -58,10 +58,11 @@ std::vector<ObjectId> check_frame(std::span<const gl::Renderer::ObjectPixels> tr
 }
 
 // The scene first: a bad spec is reported before any GL work.
-Session::Session(std::string_view scene_spec, const gl::RendererOptions& renderer_options)
+Session::Session(std::string_view scene_spec, const gl::RendererOptions& renderer_options,
+                 const BvhOptions& bvh_options)
     : bundle_(timed_make_scene(scene_spec, scene_build_ms_)) {
   const auto t0 = Clock::now();
-  bvh_ = Bvh::build(bundle_.scene);
+  bvh_ = Bvh::build(bundle_.scene, bvh_options);
   bvh_build_ms_ = ms_between(t0, Clock::now());
   context_ = gl::Context::create();
   device_ = context_->info();
@@ -97,6 +98,7 @@ FrameStats Session::run_frame(Culler& culler, const View& view, double time_s) {
   s.queries = d.queries;
   s.query_boxes = d.query_boxes;
   s.state_changes = d.state_changes;
+  s.blocking_waits = d.blocking_waits;
   s.material_changes = d.material_changes;
   s.render_flushes = d.render_flushes;
   s.draw_calls = d.draw_calls;
@@ -213,6 +215,7 @@ std::vector<AlgorithmSummary> summarize_runs(std::span<const AlgorithmRun> runs)
         sums["nodes_visited"] += double(f.nodes_visited);
         sums["extra_objects"] += double(f.extra_objects);
         sums["wait_ms"] += f.wait_ms;
+        sums["blocking_waits"] += double(f.blocking_waits);
         sums["cpu_ms"] += f.cpu_ms;
         sums["gpu_ms"] += f.gpu_ms;
         missed += f.missed_objects;
@@ -257,6 +260,7 @@ std::vector<AlgorithmSummary> summarize_runs(std::span<const AlgorithmRun> runs)
     a.nodes_visited_per_frame = med("nodes_visited");
     a.extra_objects_per_frame = med("extra_objects");
     a.wait_ms_per_frame = med("wait_ms");
+    a.blocking_waits_per_frame = med("blocking_waits");
     a.cpu_ms_per_frame = med("cpu_ms");
     a.gpu_ms_per_frame = med("gpu_ms");
     out.push_back(std::move(a));
@@ -284,7 +288,7 @@ BenchResult run_bench(const BenchConfig& config, const ProgressFn& progress) {
   ropts.query_mode = config.query_mode;
   ropts.write_ids = false;  // timed frames draw colour and depth only
   ropts.multi_draw = config.multi_draw;
-  Session session(config.scene, ropts);
+  Session session(config.scene, ropts, config.bvh);
   const CameraPath& path = config.path.empty() ? session.bundle().paths.front()
                                                : session.bundle().path(config.path);
   for (const auto& n : names) (void)session.make(n, config.options);  // options of each, early

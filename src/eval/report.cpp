@@ -127,6 +127,7 @@ void write_json(const BenchResult& r, std::ostream& out) {
                      {"worst_frame_wrong_pixels", a.worst_frame_wrong_pixels},
                      {"longest_miss_frames", a.longest_miss_frames},
                      {"wait_ms_per_frame", a.wait_ms_per_frame},
+                     {"blocking_waits_per_frame", a.blocking_waits_per_frame},
                      {"cpu_ms_per_frame", a.cpu_ms_per_frame},
                      {"gpu_ms_per_frame", a.gpu_ms_per_frame}});
   }
@@ -138,16 +139,16 @@ void write_csv(const BenchResult& r, std::ostream& out) {
   out << "algorithm,repeat,frame,frame_ms,cpu_ms,wait_ms,gpu_ms,queries,query_boxes,multiqueries,"
          "failed_multiqueries,query_batches,state_changes,material_changes,render_flushes,"
          "draw_calls,triangles,objects_rendered,nodes_visited,truth_objects,missed_objects,"
-         "wrong_pixels,extra_objects\n";
+         "wrong_pixels,extra_objects,blocking_waits\n";
   for (const AlgorithmRun& run : r.runs) {
     for (std::size_t k = 0; k < run.frames.size(); ++k) {
       const FrameStats& f = run.frames[k];
-      out << fmt::format("{},{},{},{:.4f},{:.4f},{:.4f},{:.4f},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n",
+      out << fmt::format("{},{},{},{:.4f},{:.4f},{:.4f},{:.4f},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n",
                          run.name, run.repeat, k, f.frame_ms, f.cpu_ms, f.wait_ms, f.gpu_ms, f.queries,
                          f.query_boxes, f.multiqueries, f.failed_multiqueries, f.query_batches,
                          f.state_changes, f.material_changes, f.render_flushes, f.draw_calls,
                          f.triangles, f.objects_rendered, f.nodes_visited, f.truth_objects,
-                         f.missed_objects, f.wrong_pixels, f.extra_objects);
+                         f.missed_objects, f.wrong_pixels, f.extra_objects, f.blocking_waits);
     }
   }
 }

@@ -592,6 +592,9 @@ bool Renderer::result_available(QueryId q) {
 std::uint64_t Renderer::result(QueryId q) {
   Impl& g = *impl_;
   const auto t0 = Clock::now();
+  GLuint available = GL_FALSE;
+  glGetQueryObjectuiv(g.query_names[q], GL_QUERY_RESULT_AVAILABLE, &available);
+  if (available != GL_TRUE) ++stats_.blocking_waits;
   GLuint64 samples = 0;
   glGetQueryObjectui64v(g.query_names[q], GL_QUERY_RESULT, &samples);
   const double ms = ms_since(t0);

@@ -1,0 +1,58 @@
+// GL integration: every conservative culler, with each CHC++ feature on and
+// off, renders every object the ground truth shows, on the embedded scenes,
+// with moving cars, and on a path that walks through object boxes.
+#include "occull/error.hpp"
+#include "occull/harness.hpp"
+
+#include <gtest/gtest.h>
+
+using namespace occull;
+
+namespace {
+
+constexpr int kFrames = 10;
+
+const char* const kConservative[] = {
+    "stopwait", "chc", "chc:skip=4", "chcpp", "chcpp:batch=1", "chcpp:vqueue=off",
+    "chcpp:multiquery=off", "chcpp:jitter=off", "chcpp:tight=off", "chcpp:virtual_leaf=2000"};
+
+gl::RendererOptions small_target() {
+  gl::RendererOptions o;
+  o.width = 192;
+  o.height = 108;
+  o.write_ids = false;
+  return o;
+}
+
+void expect_no_misses(Session& session, const CameraPath& path, const std::string& where) {
+  const auto truth = session.ground_truth(path, kFrames);
+  for (const char* spec : kConservative) {
+    auto culler = session.make(spec, {});
+    const AlgorithmRun run = session.run_path(spec, *culler, path, kFrames, &truth);
+    for (std::size_t k = 0; k < run.frames.size(); ++k)
+      EXPECT_EQ(run.frames[k].missed_objects, 0u) << spec << " on " << where << " frame " << k;
+  }
+}
+
+}  // namespace
+
+TEST(ConservativeCullers, MissNothingOnCityPaths) {
+  Session session("city:blocks=4,traffic=40", small_target());
+  for (const auto& path : session.bundle().paths) expect_no_misses(session, path, "city/" + path.name());
+}
+
+TEST(ConservativeCullers, MissNothingOnFieldPaths) {
+  Session session("field:objects=800,size=300", small_target());
+  for (const auto& path : session.bundle().paths) expect_no_misses(session, path, "field/" + path.name());
+}
+
+TEST(ConservativeCullers, MissNothingWhenTheCameraPassesThroughObjects) {
+  // From the middle of a street straight through a block of buildings at
+  // eye height: the eye enters and leaves object and node boxes.
+  Session session("city:blocks=3,traffic=10", small_target());
+  const Aabb city = session.bundle().scene.bounds();
+  const float z = city.center().z;
+  const CameraPath through("through", "", {{0.0, {{city.min.x + 8.0f, 1.7f, z}, -1.5708f, 0.0f}, false},
+                                          {4.0, {{city.max.x - 8.0f, 1.7f, z}, -1.5708f, 0.0f}, false}});
+  expect_no_misses(session, through, "a path through buildings");
+}
