@@ -272,3 +272,26 @@ TEST_F(RendererTest, MultiDrawGivesTheSamePixelsAsSingleDraws) {
   EXPECT_EQ(images[0], images[1]);
   EXPECT_EQ(ids_in(images[1]), (std::set<ObjectId>{0, 2, 3}));
 }
+
+TEST_F(RendererTest, BoxAroundTheEyeIsVisible) {
+  WallScene w;
+  gl::Renderer r(w.scene, small());
+  begin_with_wall(r, w);
+  // The eye inside a big box whose far faces lie behind the wall.
+  const Aabb around[] = {{{-50, -50, -50}, {50, 50, 50}}};
+  const QueryId q = r.issue_query(around);
+  EXPECT_GT(r.result(q), 0u);
+  r.end_frame();
+}
+
+TEST_F(RendererTest, QueryCountsEachVisiblePixelOnce) {
+  // Nothing drawn: a box face-on fills its projected area once (back faces culled).
+  WallScene w;
+  gl::Renderer r(w.scene, small());
+  r.begin_frame(w.view);
+  const Aabb box[] = {w.scene.object(WallScene::wall).bounds};
+  const std::uint64_t samples = r.result(r.issue_query(box));
+  r.end_frame();
+  const double area = projected_area(box[0], w.view.view_proj, kSize, kSize);
+  EXPECT_NEAR(double(samples), area, 0.1 * area);
+}

@@ -37,6 +37,10 @@ struct CameraPose {
   float pitch = 0.0f;
 };
 
+/// Distance from the eye to the corners of the near-plane rectangle: a box
+/// farther than this from the eye cannot be cut by the near plane. Scene units.
+[[nodiscard]] float near_plane_radius(const View& view);
+
 /// The view of `pose` through `lens` on a width x height viewport.
 /// Preconditions: width > 0, height > 0, |pitch| < pi/2.
 [[nodiscard]] View make_view(const CameraPose& pose, const Lens& lens, int width, int height);

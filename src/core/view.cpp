@@ -27,6 +27,13 @@ View make_view(const CameraPose& pose, const Lens& lens, int width, int height) 
   return v;
 }
 
+float near_plane_radius(const View& view) {
+  // proj[0][0] = 1 / (aspect * tan(fov/2)), proj[1][1] = 1 / tan(fov/2).
+  const float half_w = view.near / view.proj[0][0];
+  const float half_h = view.near / view.proj[1][1];
+  return std::sqrt(view.near * view.near + half_w * half_w + half_h * half_h);
+}
+
 CameraPath::CameraPath(std::string name, std::string description, std::vector<Key> keys)
     : name_(std::move(name)), description_(std::move(description)), keys_(std::move(keys)) {
   assert(!keys_.empty());

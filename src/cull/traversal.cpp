@@ -4,13 +4,6 @@
 
 namespace occull::detail {
 
-float near_plane_radius(const View& view) {
-  // proj[0][0] = 1 / (aspect * tan(fov/2)), proj[1][1] = 1 / tan(fov/2).
-  const float half_w = view.near / view.proj[0][0];
-  const float half_h = view.near / view.proj[1][1];
-  return std::sqrt(view.near * view.near + half_w * half_w + half_h * half_h);
-}
-
 void append_objects_in_frustum(const SceneIndex& index, NodeId n, const View& view,
                                std::vector<ObjectId>& out) {
   for (ObjectId id : index.bvh.objects(n))

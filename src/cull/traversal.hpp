@@ -70,10 +70,6 @@ class DistanceQueue {
   std::priority_queue<Entry, std::vector<Entry>, std::greater<>> heap_;
 };
 
-/// Distance from the eye to the corners of the near-plane rectangle: a box
-/// closer than this to the eye may be cut by the near plane.
-float near_plane_radius(const View& view);
-
 /// The eye-inside rule (DESIGN, seed 002): a box that, grown by the near
 /// plane radius, contains the eye is visible without a query — its query
 /// could miss the faces around the camera, and an object that close is

@@ -159,6 +159,8 @@ struct Renderer::Impl {
   enum class Mode { none, render, query } mode = Mode::none;
   MaterialId bound_material = ~0u;
   glm::vec3 eye{0.0f};
+  float near_radius = 0.0f;
+  bool query_culls_back = true;
   std::vector<ObjectId> opaque;
   std::vector<ObjectId> translucent;  // deferred to end_frame
   std::vector<ObjectId> frame_objects;  // everything render() got this frame
@@ -292,8 +294,8 @@ void Renderer::Impl::create_query_resources() {
     corners[i * 3 + 1] = float((i >> 1) & 1);
     corners[i * 3 + 2] = float((i >> 2) & 1);
   }
-  // Outward counter-clockwise faces (winding matters only for consistency:
-  // query boxes are drawn without face culling).
+  // Outward counter-clockwise faces: query boxes are drawn with back faces
+  // culled (unless a box is around the eye).
   const GLubyte idx[36] = {0, 2, 3, 0, 3, 1,  4, 5, 7, 4, 7, 6,  0, 4, 6, 0, 6, 2,
                            1, 3, 7, 1, 7, 5,  0, 1, 5, 0, 5, 4,  2, 6, 7, 2, 7, 3};
   glCreateBuffers(1, &cube_vertices);
@@ -356,7 +358,8 @@ void Renderer::Impl::enter_query_state(BackendStats& stats) {
   glEnable(GL_DEPTH_CLAMP);
   glEnable(GL_POLYGON_OFFSET_FILL);
   glPolygonOffset(0.0f, -2.0f);  // units only: a slope term would pull edge-on faces through walls
-  glDisable(GL_CULL_FACE);
+  glEnable(GL_CULL_FACE);  // front faces cover every visible pixel of a box the eye is outside of
+  query_culls_back = true;
 }
 
 void Renderer::Impl::draw_objects(std::span<const ObjectId> ids, BackendStats& stats) {
@@ -475,6 +478,7 @@ void Renderer::begin_frame(const View& view) {
   glProgramUniform3fv(g.scene_program, g.u_background, 1, glm::value_ptr(g.options.background));
   glProgramUniform1f(g.scene_program, g.u_fog, std::max(view.far, 1.0f));
   g.eye = view.eye;
+  g.near_radius = near_plane_radius(view);
   g.translucent.clear();
   g.frame_objects.clear();
   g.bound_material = ~0u;
@@ -558,6 +562,13 @@ QueryId Renderer::issue_query(std::span<const Aabb> boxes) {
     g.free_queries.pop_back();
   }
   ++g.in_flight;
+  // A box around the eye shows only back faces: draw both sides for it.
+  bool around_eye = false;
+  for (const Aabb& b : boxes) around_eye = around_eye || b.grown(g.near_radius).contains(g.eye);
+  if (around_eye == g.query_culls_back) {
+    if (around_eye) glDisable(GL_CULL_FACE); else glEnable(GL_CULL_FACE);
+    g.query_culls_back = !around_eye;
+  }
   const GLuint name = g.query_names[q];
   glBeginQuery(g.target, name);
   std::size_t done = 0;

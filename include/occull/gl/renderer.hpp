@@ -47,9 +47,10 @@ struct RendererOptions {
 /// colour and depth writes off, depth test LEQUAL, a constant polygon offset
 /// of 2 depth units towards the eye (no slope term: it would pull edge-on
 /// faces through walls), depth clamping (a box crossing the near plane is
-/// not clipped away) and no face culling, so that a query never reports fewer samples than
-/// the box's visible surface has. Samples therefore count front and back
-/// faces where both pass.
+/// not clipped away) and back faces culled — except for a query with a box
+/// around the eye (grown by the near-plane radius), which is drawn two-sided
+/// because the eye sees only its back faces. So a query never reports fewer
+/// samples than its boxes' visible surface has.
 ///
 /// Preconditions: a gl::Context is current on the calling thread for the
 /// renderer's whole life; `scene` outlives the renderer and keeps its
