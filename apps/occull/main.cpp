@@ -6,7 +6,9 @@
 // (EGL or driver missing).
 #include "occull/culler.hpp"
 #include "occull/error.hpp"
+#include "occull/gl/calibrate.hpp"
 #include "occull/gl/context.hpp"
+#include "occull/profile_io.hpp"
 #include "occull/harness.hpp"
 #include "occull/report.hpp"
 #include "occull/scenes.hpp"
@@ -139,6 +141,7 @@ struct BenchArgs {
   std::string csv;
   std::string report = "occull-report";
   bool no_report = false;
+  bool model = false;
 };
 
 bool parse_on_off(const std::string& flag, const std::string& s) {
@@ -190,6 +193,7 @@ int cmd_bench(const BenchArgs& a) {
     throw occull::InputError(fmt::format("--bvh-leaf {}: must be in [1, 64]", a.bvh_leaf));
   c.bvh.max_leaf_objects = a.bvh_leaf;
   c.verify = parse_on_off("--verify", a.verify);
+  c.model = a.model;
   const bool report = !a.no_report && !a.report.empty();
   const auto json = open_output(a.json);
   const auto csv = open_output(a.csv);
@@ -212,6 +216,43 @@ int cmd_bench(const BenchArgs& a) {
     const auto files = occull::write_report(result, a.report);
     std::fprintf(stderr, "report: %s/report.md (%zu files)\n", a.report.c_str(), files.size());
   }
+  return 0;
+}
+
+struct CalibrateArgs {
+  std::string size = "1280x720";
+  int repeats = 5;
+  std::string out;
+};
+
+int cmd_calibrate(const CalibrateArgs& a) {
+  const Size size = parse_size(a.size);
+  if (a.repeats < 1 || a.repeats > 100)
+    throw occull::InputError(fmt::format("--repeats {}: must be in [1, 100]", a.repeats));
+  const auto context = occull::gl::Context::create();
+  const auto device = context->info();
+  const std::string key = device.renderer + " | " + device.version;
+  occull::gl::CalibrationOptions o;
+  o.width = size.width;
+  o.height = size.height;
+  o.repeats = a.repeats;
+  const auto result = occull::gl::calibrate(o, [](const std::string& line) {
+    std::fprintf(stderr, "%s\n", line.c_str());
+  });
+  occull::HardwareProfile profile = result.profile;
+  profile.renderer = key;
+  const std::string path = a.out.empty() ? occull::default_profile_path(key) : a.out;
+  occull::save_profile(profile, path);
+  fmt::print("hardware profile of {} at {}x{} ({} rounds, {:.1f} s)\n\n", key, size.width, size.height,
+             a.repeats, result.seconds);
+  fmt::print("{:<10} {:>14} {:>8}  {}\n", "quantity", "time", "spread", "meaning");
+  for (const auto& v : result.values) {
+    const std::string time = v.value_ms >= 0.01 ? fmt::format("{:.4f} ms", v.value_ms)
+                                                 : fmt::format("{:.3f} ns", v.value_ms * 1e6);
+    fmt::print("{:<10} {:>14} {:>7.0f}%  {}\n", v.name, time, 100.0 * v.spread, v.meaning);
+  }
+  fmt::print("\nN_q (queries in flight before the oldest must be done): {}\n", profile.max_parallel_queries());
+  fmt::print("spread = (max - min) / median over the rounds; T_o^l is the maximum.\nwritten: {}\n", path);
   return 0;
 }
 
@@ -288,11 +329,20 @@ int main(int argc, char** argv) {
   b->add_option("--report", bench.report, "write report.md, SVG charts, JSON and CSV into this folder")
       ->capture_default_str();
   b->add_flag("--no-report", bench.no_report, "do not write the report folder");
+  b->add_flag("--model", bench.model,
+              "also predict every frame with the NOHC cost model and print predicted vs measured");
   b->add_option("--bvh-leaf", bench.bvh_leaf, "most objects in a BVH leaf (binned SAH decides below that)")
       ->capture_default_str();
   b->add_option("--draw", bench.draw,
                 "object submission: single (one draw per object) or multi (one multi-draw per material run)")
       ->capture_default_str();
+
+  CalibrateArgs calibrate;
+  auto* cal = app.add_subcommand("calibrate",
+                                 "measure the NOHC hardware cost model on this renderer and cache it");
+  cal->add_option("--size", calibrate.size, "render size WIDTHxHEIGHT")->capture_default_str();
+  cal->add_option("--repeats", calibrate.repeats, "rounds per measurement (median kept)")->capture_default_str();
+  cal->add_option("--out", calibrate.out, "write the profile here instead of the per-user cache");
 
   RenderArgs render;
   auto* r = app.add_subcommand("render", "render one frame of a path with an algorithm to a PNG");
@@ -320,6 +370,7 @@ int main(int argc, char** argv) {
     if (cmd == "algos") return cmd_algos();
     if (cmd == "bench") return cmd_bench(bench);
     if (cmd == "render") return cmd_render(render);
+    if (cmd == "calibrate") return cmd_calibrate(calibrate);
   } catch (const occull::InputError& e) {
     std::cerr << "occull: " << e.what() << "\n";
     return kExitInput;

@@ -18,6 +18,7 @@
 #pragma once
 
 #include "occull/bvh.hpp"
+#include "occull/cost_model.hpp"
 #include "occull/culler.hpp"
 #include "occull/gl/context.hpp"
 #include "occull/gl/renderer.hpp"
@@ -27,6 +28,7 @@
 #include <functional>
 #include <iosfwd>
 #include <memory>
+#include <optional>
 #include <span>
 #include <string>
 #include <vector>
@@ -69,6 +71,13 @@ class Session {
   Session(const Session&) = delete;
   Session& operator=(const Session&) = delete;
 
+  /// Replaces the GL context and the renderer by fresh ones, so one
+  /// algorithm's run cannot leave driver state that slows the next (seen on
+  /// llvmpipe: after `perobject`'s thousands of small flushes per frame,
+  /// chc/chcpp in the same context ran 10-20% slower for the rest of the
+  /// process). Costs a fraction of a second.
+  void reset_renderer();
+
   /// Runs one frame: moves dynamic objects to `time_s` (untimed), then
   /// times refit, begin_frame, the culler and end_frame (closed by
   /// glFinish). Fills every timing and backend counter of the result.
@@ -82,12 +91,27 @@ class Session {
   /// "chcpp:multiquery=off", see parse_algorithm_spec) for this scene;
   /// `oracle` too (run_path feeds it the truth). Throws InputError like
   /// make_culler().
-  [[nodiscard]] std::unique_ptr<Culler> make(std::string_view spec, const Options& options) const;
+  [[nodiscard]] std::unique_ptr<Culler> make(std::string_view spec, const Options& options);
 
   /// Runs `culler` over frames 0..frames-1 of `path`. With `truth` (one
   /// entry per frame), verifies every frame; the oracle needs it.
+  /// With `predict`, also fills FrameStats::model_ms (see predicted_frame_ms).
   AlgorithmRun run_path(std::string_view name, Culler& culler, const CameraPath& path, int frames,
-                        const std::vector<FrameTruth>* truth, const ProgressFn& progress = {});
+                        const std::vector<FrameTruth>* truth, const ProgressFn& progress = {},
+                        bool predict = false);
+
+  /// The NOHC hardware profile of this renderer: loaded from the per-user
+  /// cache (default_profile_path), or calibrated now — a few seconds — and
+  /// cached. Throws InputError when the cached file is corrupt.
+  const HardwareProfile& hardware_profile(const std::function<void(const std::string&)>& progress = {});
+  /// Where hardware_profile() reads and writes the profile.
+  [[nodiscard]] std::string hardware_profile_path() const;
+  /// "renderer | version": the key profiles are cached under.
+  [[nodiscard]] std::string renderer_key() const;
+
+  /// The cost model's estimate of the frame just run: t_r of every object
+  /// rendered plus t_o of every query issued (milliseconds).
+  [[nodiscard]] double predicted_frame_ms(const View& view);
 
   /// View of `path` at frame k of `frames`.
   [[nodiscard]] View view_at(const CameraPath& path, int k, int frames) const;
@@ -108,7 +132,10 @@ class Session {
   Bvh bvh_;
   std::unique_ptr<gl::Context> context_;
   gl::DeviceInfo device_;
+  gl::RendererOptions renderer_options_;
   std::unique_ptr<gl::Renderer> renderer_;
+  std::optional<HardwareProfile> profile_;
+  std::vector<double> mesh_area_;  // surface area per mesh, for the model
 };
 
 struct BenchConfig {
@@ -125,6 +152,7 @@ struct BenchConfig {
   gl::QueryMode query_mode = gl::QueryMode::samples_passed;
   bool multi_draw = false;                ///< see gl::RendererOptions::multi_draw
   BvhOptions bvh;                         ///< how the scene's hierarchy is built
+  bool model = false;                     ///< also predict each frame with the NOHC cost model
 };
 
 /// Mean, median, 95th percentile and maximum of a sample (all 0 when empty).
@@ -157,6 +185,7 @@ struct AlgorithmSummary {
   double blocking_waits_per_frame = 0.0;  ///< query reads that had to wait (sync points)
   double cpu_ms_per_frame = 0.0;
   double gpu_ms_per_frame = 0.0;
+  double model_ms_per_frame = 0.0;        ///< cost-model prediction (0 without --model)
   std::uint64_t missed_objects = 0;       ///< sum over frames of objects missed
   std::uint64_t frames_with_misses = 0;
   std::uint64_t wrong_pixels = 0;         ///< sum over frames
@@ -178,6 +207,8 @@ struct BenchResult {
   int warmup = 0;
   int repeat = 1;
   bool verified = false;
+  bool modelled = false;          ///< frames carry cost-model predictions
+  std::string profile_path;       ///< the hardware profile used (when modelled or nohc ran)
   int width = 0;
   int height = 0;
   std::vector<AlgorithmRun> runs;            ///< in execution order

@@ -14,6 +14,7 @@ struct FrameStats {
   double cpu_ms = 0.0;    ///< culler's own CPU time (frame time inside render_frame minus backend calls)
   double wait_ms = 0.0;   ///< time blocked on query results
   double gpu_ms = 0.0;    ///< GPU time from timer queries (0 when unavailable)
+  double model_ms = 0.0;  ///< the NOHC cost model's prediction of this frame (occull bench --model)
 
   // Culler counters.
   std::uint64_t nodes_visited = 0;        ///< hierarchy nodes the traversal touched

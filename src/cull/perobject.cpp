@@ -33,6 +33,7 @@ class PerObjectCuller final : public Culler {
   FrameStats render_frame(const View& view, Backend& backend) override {
     FrameStats stats;
     ++frame_;
+    backend_ = &backend;
     in_frustum_.clear();
     collect_in_frustum_front_to_back(index_, view, in_frustum_, stats);
     const float radius = near_plane_radius(view);
@@ -90,7 +91,13 @@ class PerObjectCuller final : public Culler {
     return stats;
   }
 
-  ~PerObjectCuller() override = default;
+  // Queries still running belong to the backend: read them so it can reuse
+  // them. Precondition (as for every culler): the backend outlives the culler.
+  ~PerObjectCuller() override {
+    if (!backend_) return;
+    for (State& s : state_)
+      if (s.started) (void)backend_->result(s.query);
+  }
 
  private:
   struct State {
@@ -113,6 +120,7 @@ class PerObjectCuller final : public Culler {
   std::uint64_t threshold_;
   std::vector<State> state_;
   std::uint32_t frame_ = 0;
+  Backend* backend_ = nullptr;  // of the last frame, to drain running queries
   std::vector<ObjectId> in_frustum_, occludees_;
 };
 

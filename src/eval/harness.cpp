@@ -1,6 +1,8 @@
 #include "occull/harness.hpp"
 
 #include "occull/error.hpp"
+#include "occull/gl/calibrate.hpp"
+#include "occull/profile_io.hpp"
 #include "oracle.hpp"
 
 #include <fmt/format.h>
@@ -66,7 +68,15 @@ Session::Session(std::string_view scene_spec, const gl::RendererOptions& rendere
   bvh_build_ms_ = ms_between(t0, Clock::now());
   context_ = gl::Context::create();
   device_ = context_->info();
+  renderer_options_ = renderer_options;
   renderer_ = std::make_unique<gl::Renderer>(bundle_.scene, renderer_options);
+}
+
+void Session::reset_renderer() {
+  renderer_.reset();
+  context_.reset();
+  context_ = gl::Context::create();
+  renderer_ = std::make_unique<gl::Renderer>(bundle_.scene, renderer_options_);
 }
 
 Session::~Session() {
@@ -125,15 +135,69 @@ std::vector<FrameTruth> Session::ground_truth(const CameraPath& path, int frames
   return truth;
 }
 
-std::unique_ptr<Culler> Session::make(std::string_view spec, const Options& options) const {
-  const AlgorithmSpec a = parse_algorithm_spec(spec, options);
+std::unique_ptr<Culler> Session::make(std::string_view spec, const Options& options) {
+  AlgorithmSpec a = parse_algorithm_spec(spec, options);
   if (a.name == "oracle") return std::make_unique<detail::OracleCuller>(bundle_.scene);
+  if (a.name == "nohc" && !a.options.has("nohc.profile")) {
+    (void)hardware_profile();
+    a.options.set("nohc.profile", hardware_profile_path());
+  }
   return make_culler(a.name, index(), a.options);
+}
+
+std::string Session::renderer_key() const { return device_.renderer + " | " + device_.version; }
+
+std::string Session::hardware_profile_path() const { return default_profile_path(renderer_key()); }
+
+const HardwareProfile& Session::hardware_profile(const std::function<void(const std::string&)>& progress) {
+  if (profile_) return *profile_;
+  const std::string path = hardware_profile_path();
+  profile_ = load_profile(path);
+  if (profile_ && profile_->renderer == renderer_key()) return *profile_;
+  if (progress) progress("calibrating the hardware cost model (a few seconds)");
+  gl::CalibrationOptions co;
+  co.width = renderer_->width();
+  co.height = renderer_->height();
+  gl::CalibrationResult cal = gl::calibrate(co, progress);
+  cal.profile.renderer = renderer_key();
+  save_profile(cal.profile, path);
+  profile_ = cal.profile;
+  return *profile_;
+}
+
+double Session::predicted_frame_ms(const View& view) {
+  const HardwareProfile& hw = hardware_profile();
+  const Scene& scene = bundle_.scene;
+  if (mesh_area_.empty())
+    for (const Mesh& m : scene.meshes()) mesh_area_.push_back(m.surface_area());
+  const double pixels = double(view.width) * double(view.height);
+  double ms = 0.0;
+  for (ObjectId id : renderer_->frame_objects()) {
+    const Object& o = scene.object(id);
+    const double scale = std::cbrt(std::abs(double(glm::determinant(glm::mat3(o.transform)))));
+    NodeCost c;
+    c.draws = 1;
+    c.triangles = o.triangles;
+    c.shading_cost = scene.material(o.material).shading_cost;
+    c.c_bb = projected_area(o.bounds, view.view_proj, view.width, view.height) / pixels;
+    c.r_cov = coverage_ratio(mesh_area_[o.mesh] * scale * scale, o.bounds.surface_area());
+    ms += render_time(hw, c, view.width, view.height);
+  }
+  const auto boxes = renderer_->frame_query_boxes();
+  std::size_t next = 0;
+  for (std::uint32_t n : renderer_->frame_query_sizes()) {
+    double covered = 0.0;
+    for (std::uint32_t i = 0; i < n; ++i)
+      covered += projected_area(boxes[next + i], view.view_proj, view.width, view.height) / pixels;
+    next += n;
+    ms += query_time(hw, covered, view.width, view.height);
+  }
+  return ms;
 }
 
 AlgorithmRun Session::run_path(std::string_view name, Culler& culler, const CameraPath& path,
                                int frames, const std::vector<FrameTruth>* truth,
-                               const ProgressFn& progress) {
+                               const ProgressFn& progress, bool predict) {
   auto* oracle = dynamic_cast<detail::OracleCuller*>(&culler);
   if (oracle && !truth) throw InputError("the oracle needs ground truth: run it with verification on");
   AlgorithmRun run{std::string(name), 0, {}, 0};
@@ -147,7 +211,9 @@ AlgorithmRun Session::run_path(std::string_view name, Culler& culler, const Came
       for (const auto& t : (*truth)[std::size_t(k)]) visible.push_back(t.id);
       oracle->set_visible(std::move(visible));
     }
-    FrameStats s = run_frame(culler, view_at(path, k, frames), path.frame_time(k, frames));
+    const View view = view_at(path, k, frames);
+    FrameStats s = run_frame(culler, view, path.frame_time(k, frames));
+    if (predict) s.model_ms = predicted_frame_ms(view);
     if (truth) {
       // Outside the timed region: compare what was rendered with the truth.
       const std::vector<ObjectId> missed =
@@ -218,6 +284,7 @@ std::vector<AlgorithmSummary> summarize_runs(std::span<const AlgorithmRun> runs)
         sums["blocking_waits"] += double(f.blocking_waits);
         sums["cpu_ms"] += f.cpu_ms;
         sums["gpu_ms"] += f.gpu_ms;
+        sums["model_ms"] += f.model_ms;
         missed += f.missed_objects;
         frames_missing += f.missed_objects > 0 ? 1 : 0;
         wrong += f.wrong_pixels;
@@ -263,6 +330,7 @@ std::vector<AlgorithmSummary> summarize_runs(std::span<const AlgorithmRun> runs)
     a.blocking_waits_per_frame = med("blocking_waits");
     a.cpu_ms_per_frame = med("cpu_ms");
     a.gpu_ms_per_frame = med("gpu_ms");
+    a.model_ms_per_frame = med("model_ms");
     out.push_back(std::move(a));
   }
   return out;
@@ -292,6 +360,9 @@ BenchResult run_bench(const BenchConfig& config, const ProgressFn& progress) {
   const CameraPath& path = config.path.empty() ? session.bundle().paths.front()
                                                : session.bundle().path(config.path);
   for (const auto& n : names) (void)session.make(n, config.options);  // options of each, early
+  if (config.model) (void)session.hardware_profile([&](const std::string& line) {
+    if (progress) progress(line, 0, 1, true);
+  });
 
   BenchResult result;
   result.device = session.device();
@@ -307,6 +378,10 @@ BenchResult run_bench(const BenchConfig& config, const ProgressFn& progress) {
   result.warmup = config.warmup;
   result.repeat = config.repeat;
   result.verified = config.verify;
+  result.modelled = config.model;
+  bool uses_profile = config.model;
+  for (const auto& n : names) uses_profile = uses_profile || parse_algorithm_spec(n).name == "nohc";
+  if (uses_profile) result.profile_path = session.hardware_profile_path();
   result.width = config.width;
   result.height = config.height;
 
@@ -317,6 +392,7 @@ BenchResult run_bench(const BenchConfig& config, const ProgressFn& progress) {
   for (int rep = 0; rep < config.repeat; ++rep) {
     for (const auto& name : names) {
       const std::string label = config.repeat > 1 ? fmt::format("{} #{}", name, rep + 1) : name;
+      session.reset_renderer();
       {
         auto warm = session.make(name, config.options);
         auto* oracle = dynamic_cast<detail::OracleCuller*>(warm.get());
@@ -336,7 +412,8 @@ BenchResult run_bench(const BenchConfig& config, const ProgressFn& progress) {
       AlgorithmRun run = session.run_path(name, *culler, path, config.frames, truth_ptr,
                                           [&](std::string_view, int k, int n, bool w) {
                                             if (progress) progress(label, k, n, w);
-                                          });
+                                          },
+                                          config.model);
       run.repeat = rep;
       result.runs.push_back(std::move(run));
     }

@@ -73,6 +73,15 @@ void print_table(const BenchResult& r, std::ostream& out) {
         a.state_changes_per_frame, a.draw_calls_per_frame, a.triangles_per_frame,
         misses_text(r, a.missed_objects), misses_text(r, a.wrong_pixels));
   }
+  if (r.modelled) {
+    out << fmt::format("\ncost model (NOHC, profile {}): mean frame ms\n", r.profile_path);
+    out << fmt::format("{:<{}} {:>9} {:>10} {:>8}\n", "algorithm", w, "measured", "predicted", "error");
+    for (const AlgorithmSummary& a : r.summaries) {
+      const double err = a.frame_ms.mean > 0 ? (a.model_ms_per_frame - a.frame_ms.mean) / a.frame_ms.mean : 0.0;
+      out << fmt::format("{:<{}} {:>9.2f} {:>10.2f} {:>+7.0f}%\n", a.name, w, a.frame_ms.mean,
+                         a.model_ms_per_frame, 100.0 * err);
+    }
+  }
   out << "\nframe ms: wall clock per frame (glFinish closes it)"
       << (r.repeat > 1 ? ", median over repeats" : "")
       << "; vs vfc / vs orcl: mean frame time over vfc's / oracle's in the same run.\n"
@@ -98,6 +107,8 @@ void write_json(const BenchResult& r, std::ostream& out) {
   doc["warmup"] = r.warmup;
   doc["repeat"] = r.repeat;
   doc["verified"] = r.verified;
+  doc["modelled"] = r.modelled;
+  if (!r.profile_path.empty()) doc["hardware_profile"] = r.profile_path;
   doc["size"] = {r.width, r.height};
   ordered_json algos = ordered_json::array();
   for (const AlgorithmSummary& a : r.summaries) {
@@ -129,7 +140,8 @@ void write_json(const BenchResult& r, std::ostream& out) {
                      {"wait_ms_per_frame", a.wait_ms_per_frame},
                      {"blocking_waits_per_frame", a.blocking_waits_per_frame},
                      {"cpu_ms_per_frame", a.cpu_ms_per_frame},
-                     {"gpu_ms_per_frame", a.gpu_ms_per_frame}});
+                     {"gpu_ms_per_frame", a.gpu_ms_per_frame},
+                     {"model_ms_per_frame", r.modelled ? ordered_json(a.model_ms_per_frame) : ordered_json()}});
   }
   doc["algorithms"] = algos;
   out << doc.dump(2) << "\n";
@@ -139,16 +151,16 @@ void write_csv(const BenchResult& r, std::ostream& out) {
   out << "algorithm,repeat,frame,frame_ms,cpu_ms,wait_ms,gpu_ms,queries,query_boxes,multiqueries,"
          "failed_multiqueries,query_batches,state_changes,material_changes,render_flushes,"
          "draw_calls,triangles,objects_rendered,nodes_visited,truth_objects,missed_objects,"
-         "wrong_pixels,extra_objects,blocking_waits\n";
+         "wrong_pixels,extra_objects,blocking_waits,model_ms\n";
   for (const AlgorithmRun& run : r.runs) {
     for (std::size_t k = 0; k < run.frames.size(); ++k) {
       const FrameStats& f = run.frames[k];
-      out << fmt::format("{},{},{},{:.4f},{:.4f},{:.4f},{:.4f},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n",
+      out << fmt::format("{},{},{},{:.4f},{:.4f},{:.4f},{:.4f},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{:.4f}\n",
                          run.name, run.repeat, k, f.frame_ms, f.cpu_ms, f.wait_ms, f.gpu_ms, f.queries,
                          f.query_boxes, f.multiqueries, f.failed_multiqueries, f.query_batches,
                          f.state_changes, f.material_changes, f.render_flushes, f.draw_calls,
                          f.triangles, f.objects_rendered, f.nodes_visited, f.truth_objects,
-                         f.missed_objects, f.wrong_pixels, f.extra_objects, f.blocking_waits);
+                         f.missed_objects, f.wrong_pixels, f.extra_objects, f.blocking_waits, f.model_ms);
     }
   }
 }

@@ -164,6 +164,8 @@ struct Renderer::Impl {
   std::vector<ObjectId> opaque;
   std::vector<ObjectId> translucent;  // deferred to end_frame
   std::vector<ObjectId> frame_objects;  // everything render() got this frame
+  std::vector<Aabb> frame_query_boxes;     // every query box this frame
+  std::vector<std::uint32_t> frame_query_sizes;
   GLuint truth_query = 0;             // GL_SAMPLES_PASSED, for visible_pixels only
   std::vector<std::uint32_t> pixel_counts;  // per object, scratch of visible_pixels
   GLuint indirect_buffer = 0;         // multi-draw commands, refilled every frame
@@ -481,6 +483,8 @@ void Renderer::begin_frame(const View& view) {
   g.near_radius = near_plane_radius(view);
   g.translucent.clear();
   g.frame_objects.clear();
+  g.frame_query_boxes.clear();
+  g.frame_query_sizes.clear();
   g.bound_material = ~0u;
   // Start every frame in render state without counting it as a change.
   g.mode = Impl::Mode::none;
@@ -587,6 +591,8 @@ QueryId Renderer::issue_query(std::span<const Aabb> boxes) {
     done += n;
   }
   glEndQuery(g.target);
+  g.frame_query_boxes.insert(g.frame_query_boxes.end(), boxes.begin(), boxes.end());
+  g.frame_query_sizes.push_back(std::uint32_t(boxes.size()));
   ++stats_.queries;
   stats_.query_boxes += boxes.size();
   return q;
@@ -655,6 +661,10 @@ std::vector<std::uint8_t> Renderer::read_rgba() const {
 }
 
 std::span<const ObjectId> Renderer::frame_objects() const noexcept { return impl_->frame_objects; }
+std::span<const Aabb> Renderer::frame_query_boxes() const noexcept { return impl_->frame_query_boxes; }
+std::span<const std::uint32_t> Renderer::frame_query_sizes() const noexcept {
+  return impl_->frame_query_sizes;
+}
 
 std::vector<Renderer::ObjectPixels> Renderer::visible_pixels(const View& view,
                                                              std::span<const ObjectId> objects) {

@@ -81,6 +81,11 @@ class Renderer final : public Backend {
   /// (translucent ones included).
   [[nodiscard]] std::span<const ObjectId> frame_objects() const noexcept;
 
+  /// Boxes of the queries issued since begin_frame(), in order, and how many
+  /// boxes each query had (for the cost model's prediction of a frame).
+  [[nodiscard]] std::span<const Aabb> frame_query_boxes() const noexcept;
+  [[nodiscard]] std::span<const std::uint32_t> frame_query_sizes() const noexcept;
+
   /// One object's visible area in a visible_pixels() pass.
   struct ObjectPixels {
     ObjectId id;

@@ -1,0 +1,329 @@
+// `nohc`: near optimal hierarchical culling (Guthe, Balázs, Klein 2006;
+// seed 001, Figures 4 and 5).
+//
+// A front-to-back traversal like CHC's, but every query is a priced
+// decision. Each node gets an occlusion probability from the screen
+// coverage accumulated by what was rendered before it (c_scr), its box's
+// coverage (c_bb), the object-to-box ratio R_cov and its state in the last
+// frame; and a rendering time t_r and query time t_o from the calibrated
+// hardware profile. A query is issued only where the expected saving pays
+// for it (query_reasonable). The children of a queried node are traversed
+// at once unless the node was occluded last frame (then they wait for the
+// answer); an occluded answer cancels the children already queued. At most
+// N_q queries are in flight before the oldest is taken as finished.
+//
+// Rendering goes through a render queue handed to the backend before each
+// query and each wait, so every query still tests against everything nearer.
+#include "nohc.hpp"
+
+#include "cullers.hpp"
+#include "occull/error.hpp"
+#include "occull/profile_io.hpp"
+#include "traversal.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <deque>
+#include <numeric>
+
+namespace occull::detail {
+
+double query_benefit(const NodeEstimate& n, double levels) {
+  return n.p_occl * (n.t_r - n.t_o) / std::max(levels, 1e-9);
+}
+
+bool query_reasonable(const ReasonabilityInput& in) {
+  const NodeEstimate& n = in.node;
+  double children_cost = 0.0, children_benefit = 0.0;
+  bool cheap_child = false;
+  for (const NodeEstimate& c : in.children) {
+    children_cost += c.t_o;
+    children_benefit += query_benefit(c, in.levels);
+    cheap_child = cheap_child || c.t_r < c.t_o;
+  }
+  if (n.t_r < n.t_o) return false;
+  if (!in.children.empty() && children_cost < n.t_o) return false;
+  if (in.previous == PreviousState::occluded) return true;
+  if (in.previous == PreviousState::outside) {
+    // No coherence to use: query only if that is expected to be faster.
+    if (n.t_o + (1.0 - n.p_occl) * n.t_r >= n.t_r) return false;
+  } else if (n.t_o > double(in.frames_since_query) * query_benefit(n, in.levels)) {
+    return false;
+  }
+  if (cheap_child) return true;
+  return query_benefit(n, in.levels) > children_benefit &&
+         in.query_overhead_ms * double(n.leaves) > n.t_o;
+}
+
+namespace {
+
+struct NohcConfig {
+  std::uint64_t threshold = 0;
+  double fragments_per_pixel = 2.0;
+  double visible_factor = 0.5;   // p_occl = factor · p_cov^2 for previously visible nodes
+  double levels = 0.0;           // 0: log2(N_h + 1)
+  int max_parallel = 0;          // 0: N_q from the profile
+  bool exact_area = true;        // projected box area instead of the paper's approximation
+  std::uint32_t virtual_leaf = 0;
+};
+
+class NohcCuller final : public Culler {
+ public:
+  NohcCuller(const SceneIndex& index, const NohcConfig& config, HardwareProfile profile)
+      : index_(index), config_(config), hw_(std::move(profile)), nodes_(index.bvh.size()) {
+    // Per node: draws, triangles, triangle-weighted shading cost, object surface area.
+    const Bvh& bvh = index.bvh;
+    for (NodeId n = NodeId(bvh.size()); n-- > 0;) {
+      NodeInfo& info = nodes_[n];
+      double weighted = 0.0;
+      for (ObjectId id : bvh.objects(n)) {
+        const Object& o = index.scene.object(id);
+        const double scale = std::cbrt(std::abs(double(glm::determinant(glm::mat3(o.transform)))));
+        info.area += index.scene.mesh(o.mesh).surface_area() * scale * scale;
+        weighted += double(o.triangles) * double(index.scene.material(o.material).shading_cost);
+      }
+      info.shading = bvh.node(n).triangles > 0 ? weighted / double(bvh.node(n).triangles) : 0.0;
+    }
+    levels_ = config.levels > 0.0 ? config.levels : std::log2(double(bvh.size()) + 1.0);
+    max_parallel_ = config.max_parallel > 0 ? config.max_parallel : std::max(1, hw_.max_parallel_queries());
+  }
+
+  FrameStats render_frame(const View& view, Backend& backend) override {
+    ++frame_;
+    if (nodes_.size() != index_.bvh.size()) nodes_.assign(index_.bvh.size(), NodeInfo{});
+    stats_ = {};
+    view_ = &view;
+    backend_ = &backend;
+    radius_ = near_plane_radius(view);
+    fov_y_ = 2.0 * std::atan(1.0 / double(view.proj[1][1]));
+    c_scr_ = 0.0;
+
+    distance_queue_.push(index_.bvh, Bvh::root(), view.eye);
+    while (!distance_queue_.empty() || !query_queue_.empty()) {
+      while (!query_queue_.empty() && first_query_finished()) handle_returned_query();
+      if (distance_queue_.empty()) {
+        if (!query_queue_.empty()) {
+          flush_render_queue();
+          handle_returned_query();  // nothing else to do: wait
+        }
+        continue;
+      }
+      const NodeId n = distance_queue_.pop();
+      if (cancelled(n)) continue;
+      visit(n);
+    }
+    flush_render_queue();
+    return stats_;
+  }
+
+ private:
+  struct NodeInfo {
+    double area = 0.0;     // object surface area in the subtree
+    double shading = 0.0;  // triangle-weighted mean shading cost
+    std::uint32_t last_visited = kNever;
+    std::uint32_t frames_since_query = 0;
+    std::uint32_t cancelled = kNever;   // frame in which an ancestor was found occluded
+    std::uint32_t cost_frame = kNever;  // frame of the cached c_bb
+    double c_bb = 0.0;
+    PreviousState state = PreviousState::outside;  // this frame's, once known
+    bool visible = false;
+  };
+  struct Pending {
+    QueryId id;
+    NodeId node;
+    bool wait;  // children held back until the answer
+  };
+
+  bool is_leaf(NodeId n) const { return index_.bvh.is_leaf(n, config_.virtual_leaf); }
+
+  PreviousState previous_state(NodeId n) const {
+    const NodeInfo& i = nodes_[n];
+    if (i.last_visited == kNever || i.last_visited + 1 != frame_) return PreviousState::outside;
+    return i.state;
+  }
+
+  bool cancelled(NodeId n) const {
+    for (NodeId a = n; a != kNoNode; a = index_.bvh.node(a).parent)
+      if (nodes_[a].cancelled == frame_) return true;
+    return false;
+  }
+
+  double c_bb(NodeId n) {
+    NodeInfo& i = nodes_[n];
+    if (i.cost_frame != frame_) {
+      const Aabb& box = index_.bvh.node(n).bounds;
+      if (config_.exact_area) {
+        i.c_bb = projected_area(box, view_->view_proj, view_->width, view_->height) /
+                 (double(view_->width) * double(view_->height));
+      } else {
+        i.c_bb = bbox_screen_fraction(box.surface_area(), distance(view_->eye, box), view_->width,
+                                      view_->height, fov_y_);
+      }
+      i.cost_frame = frame_;
+    }
+    return i.c_bb;
+  }
+
+  NodeEstimate estimate(NodeId n) {
+    const BvhNode& node = index_.bvh.node(n);
+    NodeCost cost;
+    cost.draws = node.object_count;
+    cost.triangles = node.triangles;
+    cost.shading_cost = nodes_[n].shading;
+    cost.c_bb = c_bb(n);
+    cost.r_cov = coverage_ratio(nodes_[n].area, node.bounds.surface_area());
+    NodeEstimate e;
+    e.t_r = render_time(hw_, cost, view_->width, view_->height, config_.fragments_per_pixel);
+    e.t_o = query_time(hw_, cost.c_bb, view_->width, view_->height);
+    double p = occlusion_probability(previous_state(n), coverage_probability(c_scr_, cost.c_bb));
+    if (previous_state(n) == PreviousState::visible) p *= config_.visible_factor / 0.5;
+    e.p_occl = std::clamp(p, 0.0, 1.0);
+    e.leaves = node.object_count;
+    return e;
+  }
+
+  void visit(NodeId n) {
+    ++stats_.nodes_visited;
+    NodeInfo& info = nodes_[n];
+    const PreviousState previous = previous_state(n);
+    info.visible = false;
+    info.last_visited = frame_;
+    info.state = PreviousState::outside;
+    const BvhNode& node = index_.bvh.node(n);
+    if (node.object_count == 0 || view_->frustum.classify(node.bounds) == Containment::outside) return;
+    info.state = PreviousState::visible;  // until a query says otherwise
+    if (near_eye(node.bounds, *view_, radius_)) {
+      process(n);
+      return;
+    }
+    ReasonabilityInput in;
+    in.node = estimate(n);
+    NodeEstimate kids[2];
+    if (!is_leaf(n)) {
+      kids[0] = child_estimate(Bvh::left(n));
+      kids[1] = child_estimate(index_.bvh.right(n));
+      in.children = std::span<const NodeEstimate>(kids, 2);
+    }
+    in.previous = previous;
+    in.frames_since_query = info.frames_since_query;
+    in.levels = levels_;
+    in.query_overhead_ms = hw_.query_overhead_ms;
+    if (query_reasonable(in)) {
+      flush_render_queue();
+      boxes_.clear();
+      append_query_boxes(index_, n, {}, boxes_);
+      const bool wait = previous == PreviousState::occluded;
+      query_queue_.push_back({backend_->issue_query(boxes_), n, wait});
+      ++stats_.query_batches;
+      info.frames_since_query = 0;
+      if (!wait) process(n);
+    } else {
+      ++info.frames_since_query;
+      process(n);
+    }
+  }
+
+  // A child outside the frustum costs nothing to query (the granularity rule
+  // then prefers querying the children).
+  NodeEstimate child_estimate(NodeId c) {
+    if (index_.bvh.node(c).object_count == 0 ||
+        view_->frustum.classify(index_.bvh.node(c).bounds) == Containment::outside)
+      return {0.0, 0.0, 0.0, 0};
+    return estimate(c);
+  }
+
+  void process(NodeId n) {
+    if (is_leaf(n)) {
+      const std::size_t before = render_queue_.size();
+      append_objects_in_frustum(index_, n, *view_, render_queue_);
+      if (render_queue_.size() > before) {
+        NodeCost cost;
+        cost.c_bb = c_bb(n);
+        cost.r_cov = coverage_ratio(nodes_[n].area, index_.bvh.node(n).bounds.surface_area());
+        c_scr_ = accumulate_coverage(c_scr_, object_screen_fraction(cost));
+      }
+      pull_up(n);
+    } else {
+      distance_queue_.push(index_.bvh, Bvh::left(n), view_->eye);
+      distance_queue_.push(index_.bvh, index_.bvh.right(n), view_->eye);
+    }
+  }
+
+  void pull_up(NodeId n) {
+    for (; n != kNoNode && !nodes_[n].visible; n = index_.bvh.node(n).parent) {
+      nodes_[n].visible = true;
+      nodes_[n].state = PreviousState::visible;
+    }
+  }
+
+  bool first_query_finished() {
+    if (int(query_queue_.size()) >= max_parallel_) return true;  // the N_q rule
+    return backend_->result_available(query_queue_.front().id);
+  }
+
+  void handle_returned_query() {
+    const Pending q = query_queue_.front();
+    query_queue_.pop_front();
+    const bool visible = backend_->result(q.id) > config_.threshold;
+    if (cancelled(q.node)) return;  // an ancestor is occluded: nothing to do
+    NodeInfo& info = nodes_[q.node];
+    if (visible) {
+      if (is_leaf(q.node)) pull_up(q.node);
+      if (q.wait) process(q.node);
+    } else {
+      info.state = PreviousState::occluded;
+      info.visible = false;
+      if (!q.wait) info.cancelled = frame_;  // drop the children queued meanwhile
+    }
+  }
+
+  void flush_render_queue() {
+    if (render_queue_.empty()) return;
+    backend_->render(render_queue_);
+    render_queue_.clear();
+  }
+
+  SceneIndex index_;
+  NohcConfig config_;
+  HardwareProfile hw_;
+  std::vector<NodeInfo> nodes_;
+  double levels_ = 1.0;
+  int max_parallel_ = 1;
+  std::uint32_t frame_ = 0;
+
+  // Per frame.
+  FrameStats stats_;
+  const View* view_ = nullptr;
+  Backend* backend_ = nullptr;
+  float radius_ = 0.0f;
+  double fov_y_ = 1.0;
+  double c_scr_ = 0.0;
+  DistanceQueue distance_queue_;
+  std::deque<Pending> query_queue_;
+  std::vector<ObjectId> render_queue_;
+  std::vector<Aabb> boxes_;
+};
+
+}  // namespace
+
+std::unique_ptr<Culler> make_nohc(const SceneIndex& index, const Options& o) {
+  NohcConfig c;
+  c.threshold = std::uint64_t(o.get_int("nohc.threshold", 0, 0, 1 << 24));
+  c.fragments_per_pixel = o.get_double("nohc.fragments_per_pixel", c.fragments_per_pixel, 0.0, 100.0);
+  c.visible_factor = o.get_double("nohc.visible_factor", c.visible_factor, 0.0, 1.0);
+  c.levels = o.get_double("nohc.levels", c.levels, 0.0, 1000.0);
+  c.max_parallel = o.get_int("nohc.max_parallel", c.max_parallel, 0, 100000);
+  c.exact_area = o.get_bool("nohc.exact_area", c.exact_area);
+  c.virtual_leaf = std::uint32_t(o.get_int("nohc.virtual_leaf", 0, 0, 1 << 30));
+  const auto it = o.values().find("nohc.profile");
+  if (it == o.values().end() || it->second.empty())
+    throw InputError("nohc needs a hardware profile: run `occull calibrate` (occull bench does it "
+                     "for you), or pass --opt nohc.profile=FILE");
+  std::optional<HardwareProfile> profile = load_profile(it->second);
+  if (!profile) throw InputError(fmt::format("nohc.profile: '{}' does not exist", it->second));
+  return std::make_unique<NohcCuller>(index, c, std::move(*profile));
+}
+
+}  // namespace occull::detail

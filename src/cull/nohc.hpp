@@ -1,0 +1,45 @@
+// Internal: the decision at the heart of NOHC — is a query for this node
+// reasonable? (seed 001, Sections 4.1–4.2, Figure 5) — as a pure function,
+// so unit tests can walk its branches. The culler is in nohc.cpp.
+#pragma once
+
+#include "occull/cost_model.hpp"
+
+#include <cstdint>
+#include <span>
+
+namespace occull::detail {
+
+/// A node's estimates in the current view.
+struct NodeEstimate {
+  double t_r = 0.0;        ///< rendering time, ms
+  double t_o = 0.0;        ///< query time, ms
+  double p_occl = 0.0;     ///< occlusion probability
+  std::uint32_t leaves = 1;  ///< N_l: leaves of its subtree
+};
+
+/// B(H) = p_occl (t_r - t_o) / levels, levels = log2(N_h + 1) by default.
+[[nodiscard]] double query_benefit(const NodeEstimate& n, double levels);
+
+struct ReasonabilityInput {
+  NodeEstimate node;
+  std::span<const NodeEstimate> children;  ///< empty for a leaf
+  PreviousState previous = PreviousState::outside;
+  std::uint32_t frames_since_query = 0;   ///< n: frames rendered without a query
+  double levels = 1.0;                    ///< the benefit is spread over this many levels
+  double query_overhead_ms = 0.0;         ///< T_o^o
+};
+
+/// Figure 5, with Section 4.1's rule for nodes that were outside the
+/// frustum (query only if t_o + (1 - p_occl) t_r < t_r):
+///  - never when rendering is cheaper than querying, or querying the
+///    children is cheaper than querying the node;
+///  - always when the node was occluded;
+///  - for a previously visible node only when its cost is paid back by n
+///    frames of benefit, C <= n B;
+///  - then at this level only if a child is too cheap to query, or the node's
+///    benefit exceeds its children's and querying every leaf during
+///    rendering (T_o^o N_l) would cost more than this one query.
+[[nodiscard]] bool query_reasonable(const ReasonabilityInput& in);
+
+}  // namespace occull::detail

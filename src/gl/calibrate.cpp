@@ -1,0 +1,196 @@
+#include "occull/gl/calibrate.hpp"
+
+#include "occull/gl/renderer.hpp"
+
+#include <fmt/format.h>
+#include <glm/gtc/matrix_transform.hpp>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <map>
+
+namespace occull::gl {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double ms_since(Clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+}
+
+// A unit square in the XY plane, centred at the origin, facing +Z.
+Mesh quad_mesh() {
+  Mesh m;
+  m.positions = {{-0.5f, -0.5f, 0}, {0.5f, -0.5f, 0}, {0.5f, 0.5f, 0}, {-0.5f, 0.5f, 0}};
+  m.normals.assign(4, glm::vec3(0, 0, 1));
+  m.indices = {0, 1, 2, 0, 2, 3};
+  return m;
+}
+
+// The same square as a cells x cells grid: 2 cells^2 triangles.
+Mesh grid_mesh(int cells) {
+  Mesh m;
+  for (int j = 0; j <= cells; ++j)
+    for (int i = 0; i <= cells; ++i) {
+      m.positions.emplace_back(float(i) / float(cells) - 0.5f, float(j) / float(cells) - 0.5f, 0.0f);
+      m.normals.emplace_back(0, 0, 1);
+    }
+  const auto at = [cells](int i, int j) { return std::uint32_t(j * (cells + 1) + i); };
+  for (int j = 0; j < cells; ++j)
+    for (int i = 0; i < cells; ++i)
+      m.indices.insert(m.indices.end(), {at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j),
+                                         at(i + 1, j + 1), at(i, j + 1)});
+  return m;
+}
+
+glm::mat4 placed(float size, float z) {
+  return glm::scale(glm::translate(glm::mat4(1.0f), {0.0f, 0.0f, z}), glm::vec3(size, size, 1.0f));
+}
+
+struct Median {
+  double value = 0.0;
+  double spread = 0.0;
+};
+
+Median median_of(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  Median m;
+  m.value = v[v.size() / 2];
+  if (v.size() % 2 == 0) m.value = 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
+  m.spread = m.value != 0.0 ? (v.back() - v.front()) / std::abs(m.value) : 0.0;
+  return m;
+}
+
+constexpr int kFullQuads = 6;  // full-screen quads per fragment measurement
+
+}  // namespace
+
+CalibrationResult calibrate(const CalibrationOptions& options,
+                            const std::function<void(const std::string&)>& progress) {
+  const auto start = Clock::now();
+  const int w = options.width, h = options.height;
+  const double pixels = double(w) * double(h);
+
+  // The calibration scene: pixel-sized low and high meshes 1 m ahead, and
+  // per shading class a stack of full-screen quads, far to near.
+  Scene scene("calibration");
+  const MeshId quad = scene.add_mesh(quad_mesh());
+  const MeshId grid = scene.add_mesh(grid_mesh(224));  // 100,352 triangles
+  const double high_triangles = double(scene.mesh(grid).triangle_count());
+  const MaterialId plain = scene.add_material({"plain", {0.7f, 0.7f, 0.7f, 1.0f}, false, 0});
+  const ObjectId small_low = scene.add_object(quad, plain, placed(0.002f, -1.0f), OccluderClass::never);
+  const ObjectId small_high = scene.add_object(grid, plain, placed(0.002f, -1.0f), OccluderClass::never);
+  std::map<int, std::vector<ObjectId>> full;  // class -> quads, far to near
+  for (int cost : options.shading_classes) {
+    const MaterialId m = scene.add_material({fmt::format("cost {}", cost), {0.6f, 0.6f, 0.6f, 1.0f}, false, cost});
+    for (int k = 0; k < kFullQuads; ++k)
+      full[cost].push_back(scene.add_object(quad, m, placed(50.0f, -(3.0f - 0.1f * float(k))), OccluderClass::never));
+  }
+  const Aabb small_box{{-0.001f, -0.001f, -1.001f}, {0.001f, 0.001f, -0.999f}};
+  const Aabb full_box{{-20.0f, -20.0f, -6.0f}, {20.0f, 20.0f, -5.0f}};
+
+  RendererOptions ro;
+  ro.width = w;
+  ro.height = h;
+  ro.write_ids = false;
+  Renderer r(scene, ro);
+  const View view = make_view({{0, 0, 0}, 0, 0}, {60.0f, 0.1f, 100.0f}, w, h);
+
+  const auto frame_ms = [&](const std::function<void()>& work) {
+    const auto t0 = Clock::now();
+    r.begin_frame(view);
+    work();
+    r.end_frame();
+    return ms_since(t0);
+  };
+  const std::vector<ObjectId> many_low(2000, small_low);
+  const std::vector<ObjectId> some_high(12, small_high);
+  const auto draw_many_low = [&] { r.render(many_low); };
+  const auto draw_some_high = [&] { r.render(some_high); };
+  const auto queries = [&](const Aabb& box, int n) {
+    std::vector<QueryId> ids;
+    for (int i = 0; i < n; ++i) ids.push_back(r.issue_query(std::span<const Aabb>(&box, 1)));
+    for (QueryId q : ids) (void)r.result(q);
+  };
+  const auto interleaved = [&](bool with_queries) {
+    std::vector<QueryId> ids;
+    for (int i = 0; i < 500; ++i) {
+      r.render(std::span<const ObjectId>(&small_low, 1));
+      if (with_queries) ids.push_back(r.issue_query(std::span<const Aabb>(&small_box, 1)));
+    }
+    for (QueryId q : ids) (void)r.result(q);
+  };
+  const auto latency = [&] {
+    double worst = 0.0;
+    for (int i = 0; i < 20; ++i) {
+      r.begin_frame(view);
+      const auto t0 = Clock::now();
+      const QueryId q = r.issue_query(std::span<const Aabb>(&small_box, 1));
+      r.flush();
+      while (!r.result_available(q)) {
+      }
+      worst = std::max(worst, ms_since(t0));
+      (void)r.result(q);
+      r.end_frame();
+    }
+    return worst;
+  };
+
+  // Warm up every workload once (shader JIT).
+  frame_ms(draw_many_low);
+  frame_ms(draw_some_high);
+  for (auto& [cost, ids] : full) frame_ms([&] { r.render(ids); });
+  frame_ms([&] { queries(small_box, 10); });
+  frame_ms([&] { queries(full_box, 2); });
+
+  std::map<std::string, std::vector<double>> samples;
+  for (int rep = 0; rep < std::max(1, options.repeats); ++rep) {
+    const double empty = frame_ms([] {});
+    const double setup = std::max(0.0, (frame_ms(draw_many_low) - empty) / double(many_low.size()));
+    const double triangle = std::max(
+        0.0, (frame_ms(draw_some_high) - empty - double(some_high.size()) * setup) /
+                 (double(some_high.size()) * high_triangles));
+    samples["T_r^s"].push_back(setup);
+    samples["T_r^tri"].push_back(triangle);
+    for (auto& [cost, ids] : full) {
+      const double t = frame_ms([&] { r.render(ids); }) - empty - double(ids.size()) * (setup + 2.0 * triangle);
+      samples[fmt::format("T_r^f[{}]", cost)].push_back(std::max(0.0, t / (double(ids.size()) * pixels)));
+    }
+    const double q_setup = std::max(0.0, (frame_ms([&] { queries(small_box, 1000); }) - empty) / 1000.0);
+    samples["T_o^s"].push_back(q_setup);
+    samples["T_o^f"].push_back(
+        std::max(0.0, (frame_ms([&] { queries(full_box, 20); }) - empty - 20.0 * q_setup) / (20.0 * pixels)));
+    samples["T_o^l"].push_back(latency());
+    const double plain_ms = frame_ms([&] { interleaved(false); });
+    const double with_ms = frame_ms([&] { interleaved(true); });
+    samples["T_o^o"].push_back(std::max(0.0, (with_ms - plain_ms) / 500.0));
+    if (progress) progress(fmt::format("calibration round {} of {} done", rep + 1, options.repeats));
+  }
+
+  CalibrationResult result;
+  HardwareProfile& p = result.profile;
+  p.width = w;
+  p.height = h;
+  const auto take = [&](const std::string& key, const std::string& name, const std::string& meaning,
+                        double& into) {
+    const Median m = key == "T_o^l" ? Median{*std::max_element(samples[key].begin(), samples[key].end()),
+                                             median_of(samples[key]).spread}
+                                    : median_of(samples[key]);
+    into = m.value;
+    result.values.push_back({name, meaning, m.value, m.spread});
+  };
+  take("T_r^s", "T_r^s", "setup per draw call", p.draw_setup_ms);
+  take("T_r^tri", "T_r^tri", "per rendered triangle", p.triangle_ms);
+  for (int cost : options.shading_classes)
+    take(fmt::format("T_r^f[{}]", cost), fmt::format("T_r^f[{}]", cost),
+         fmt::format("per shaded fragment, shading cost {}", cost), p.fragment_ms[cost]);
+  take("T_o^s", "T_o^s", "setup per occlusion query", p.query_setup_ms);
+  take("T_o^f", "T_o^f", "per query-box fragment", p.query_fragment_ms);
+  take("T_o^l", "T_o^l", "longest query latency (max over rounds)", p.query_latency_ms);
+  take("T_o^o", "T_o^o", "a query issued while rendering, over rendering alone", p.query_overhead_ms);
+  result.seconds = ms_since(start) / 1000.0;
+  return result;
+}
+
+}  // namespace occull::gl
