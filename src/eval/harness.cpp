@@ -156,6 +156,7 @@ const HardwareProfile& Session::hardware_profile(const std::function<void(const 
   if (profile_ && profile_->renderer == renderer_key()) return *profile_;
   if (progress) progress("calibrating the hardware cost model (a few seconds)");
   gl::CalibrationOptions co;
+  co.repeats = 3;  // a first-use calibration stays within a few seconds
   co.width = renderer_->width();
   co.height = renderer_->height();
   gl::CalibrationResult cal = gl::calibrate(co, progress);
