@@ -5,16 +5,20 @@ BUILD ?= build
 JOBS ?= $(shell nproc)
 CMAKE_FLAGS ?=
 
-.PHONY: demo test deps configure build install clean
+.PHONY: demo test deps data configure build install clean
 
 demo: build
 	./$(BUILD)/occull bench
 
-test: build
+test: build data
 	cd $(BUILD) && ctest --output-on-failure -j $(JOBS)
 
 deps:
 	./scripts/install-deps.sh
+
+# The OpenArena maps (Quake 3 levels) the real-map tests and benchmarks use, into data/.
+data: deps
+	./scripts/fetch-data.sh
 
 configure: deps
 	cmake -S . -B $(BUILD) -G Ninja -DCMAKE_BUILD_TYPE=Release $(CMAKE_FLAGS)

@@ -162,3 +162,68 @@ TEST(Cli, UnwritableReportFolderIsAClearError) {
   EXPECT_EQ(r.code, 2) << r.output;
   EXPECT_NE(r.output.find("/proc/occull-report"), std::string::npos) << r.output;
 }
+
+TEST(Cli, CalibrateWritesAProfileThatNohcLoads) {
+  const std::string profile = ::testing::TempDir() + "occull_profile.json";
+  std::remove(profile.c_str());
+  const CliRun cal = run("calibrate --size 160x90 --repeats 1 --out " + profile);
+  ASSERT_EQ(cal.code, 0) << cal.output;
+  for (const char* q : {"T_r^s", "T_r^tri", "T_r^f[0]", "T_o^s", "T_o^f", "T_o^l", "T_o^o", " ms", "ns"})
+    EXPECT_NE(cal.output.find(q), std::string::npos) << q;
+  const CliRun bench = run(std::string("bench ") + kTinyCity + " --algo nohc --frames 2 --warmup 0 --no-report --opt nohc.profile=" + profile);
+  EXPECT_EQ(bench.code, 0) << bench.output;
+}
+
+TEST(Cli, CorruptProfileIsAClearError) {
+  const std::string profile = ::testing::TempDir() + "occull_bad_profile.json";
+  std::ofstream(profile) << "{\"renderer\": \"x\", \"size\": [1, 1]}";
+  const CliRun r = run(std::string("bench ") + kTinyCity + " --algo nohc --frames 1 --no-report --opt nohc.profile=" + profile);
+  EXPECT_EQ(r.code, 2) << r.output;
+  EXPECT_NE(r.output.find(profile), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("draw_setup_ms"), std::string::npos) << r.output;
+}
+
+TEST(Cli, ListMapsOfAnArchive) {
+  const std::string pk3 = std::string(OCCULL_DATA_DIR) + "/openarena/pak1-maps.pk3";
+  if (!std::ifstream(pk3)) GTEST_SKIP() << pk3 << " missing: run make data";
+  const CliRun r = run("scenes --list-maps " + pk3);
+  EXPECT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("50 maps"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("oasago2"), std::string::npos);
+}
+
+TEST(Cli, BadLevelFilesExitTwoNamingTheFile) {
+  const std::string junk = ::testing::TempDir() + "occull_junk.pk3";
+  std::ofstream(junk) << "junk";
+  CliRun r = run("bench --scene q3:" + junk + ":x --frames 1 --no-report");
+  EXPECT_EQ(r.code, 2) << r.output;
+  EXPECT_NE(r.output.find("not a zip"), std::string::npos) << r.output;
+  const std::string bsp = ::testing::TempDir() + "occull_junk.bsp";
+  std::ofstream(bsp) << "IBSP";
+  r = run("render --scene q3:" + bsp + " --out /dev/null");
+  EXPECT_EQ(r.code, 2) << r.output;
+  EXPECT_NE(r.output.find("truncated"), std::string::npos) << r.output;
+  r = run("bench --scene file:/nonexistent/model.gltf --frames 1 --no-report");
+  EXPECT_EQ(r.code, 2) << r.output;
+  EXPECT_NE(r.output.find("no such file"), std::string::npos) << r.output;
+}
+
+TEST(Cli, WrittenPathReplaysThroughFilePaths) {
+  const std::string file = ::testing::TempDir() + "occull_street.path";
+  const CliRun w = run(std::string("path --scene city:blocks=3 --path street --out ") + file);
+  ASSERT_EQ(w.code, 0) << w.output;
+  const CliRun r = run(std::string("bench ") + kTinyCity + " --path file:" + file + " --algo vfc --frames 3 --warmup 0 --no-report");
+  EXPECT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("path file:occull_street.path"), std::string::npos) << r.output;
+}
+
+TEST(Cli, ModelFilesLoadThroughAssimp) {
+  // A cube written as Wavefront OBJ.
+  const std::string obj = ::testing::TempDir() + "occull_cube.obj";
+  std::ofstream(obj) << "v -1 -1 -1\nv 1 -1 -1\nv 1 1 -1\nv -1 1 -1\nv -1 -1 1\nv 1 -1 1\nv 1 1 1\nv -1 1 1\n"
+                        "f 1 3 2\nf 1 4 3\nf 5 6 7\nf 5 7 8\nf 1 2 6\nf 1 6 5\nf 4 8 7\nf 4 7 3\nf 1 5 8\nf 1 8 4\n"
+                        "f 2 3 7\nf 2 7 6\n";
+  const CliRun r = run("bench --scene file:" + obj + " --algo vfc,chcpp,oracle --frames 4 --warmup 0 --size 96x54 --no-report");
+  EXPECT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("12 triangles"), std::string::npos) << r.output;
+}

@@ -6,6 +6,8 @@
 
 #include <gtest/gtest.h>
 
+#include <filesystem>
+
 using namespace occull;
 
 namespace {
@@ -14,7 +16,7 @@ constexpr int kFrames = 10;
 
 const char* const kConservative[] = {
     "stopwait", "chc", "chc:skip=4", "chcpp", "chcpp:batch=1", "chcpp:vqueue=off",
-    "chcpp:multiquery=off", "chcpp:jitter=off", "chcpp:tight=off", "chcpp:virtual_leaf=2000"};
+    "chcpp:multiquery=off", "chcpp:jitter=off", "chcpp:tight=off", "chcpp:virtual_leaf=0", "nohc"};
 
 gl::RendererOptions small_target() {
   gl::RendererOptions o;
@@ -55,4 +57,13 @@ TEST(ConservativeCullers, MissNothingWhenTheCameraPassesThroughObjects) {
   const CameraPath through("through", "", {{0.0, {{city.min.x + 8.0f, 1.7f, z}, -1.5708f, 0.0f}, false},
                                           {4.0, {{city.max.x - 8.0f, 1.7f, z}, -1.5708f, 0.0f}, false}});
   expect_no_misses(session, through, "a path through buildings");
+}
+
+TEST(ConservativeCullers, MissNothingOnOpenArenaTours) {
+  const std::string pk3 = std::string(OCCULL_DATA_DIR) + "/openarena/pak1-maps.pk3";
+  if (!std::filesystem::exists(pk3)) GTEST_SKIP() << pk3 << " missing: run make data";
+  for (const char* map : {"oasago2", "ctf_inyard", "oa_dm1"}) {
+    Session session(std::string("q3:") + pk3 + ":" + map, small_target());
+    expect_no_misses(session, session.path("tour"), std::string("q3 ") + map + " tour");
+  }
 }

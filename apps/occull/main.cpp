@@ -9,6 +9,7 @@
 #include "occull/gl/calibrate.hpp"
 #include "occull/gl/context.hpp"
 #include "occull/profile_io.hpp"
+#include "occull/q3bsp.hpp"
 #include "occull/harness.hpp"
 #include "occull/report.hpp"
 #include "occull/scenes.hpp"
@@ -81,6 +82,29 @@ int cmd_info() {
   return 0;
 }
 
+int cmd_list_maps(const std::string& pk3) {
+  const auto maps = occull::q3::list_maps(pk3);
+  fmt::print("{} maps in {} (use --scene q3:{}:NAME):\n", maps.size(), pk3, pk3);
+  for (const auto& m : maps) fmt::print("  {}\n", m);
+  return 0;
+}
+
+struct PathArgs {
+  std::string scene = "city";
+  std::string path;
+  std::string out;
+};
+
+int cmd_path(const PathArgs& a) {
+  if (a.out.empty()) throw occull::InputError("--out FILE is required");
+  const occull::SceneBundle bundle = occull::make_scene(a.scene);
+  const occull::CameraPath& path = a.path.empty() ? bundle.paths.front() : bundle.path(a.path);
+  occull::write_path_file(path, a.out);
+  fmt::print("wrote {} ({} poses, {:.1f} s) of {} / {}; replay it with --path file:{}\n", a.out,
+             path.keys().size(), path.duration(), a.scene, path.name(), a.out);
+  return 0;
+}
+
 int cmd_scenes() {
   for (const auto& info : occull::embedded_scenes()) {
     const auto bundle = occull::make_scene(info.name);
@@ -96,6 +120,10 @@ int cmd_scenes() {
       fmt::print("    {:<10} {:.1f} s  {}\n", path.name(), path.duration(), path.description());
     fmt::print("\n");
   }
+  fmt::print("q3:FILE.pk3:MAP, q3:FILE.bsp — a Quake 3 level (IBSP 46); path tour. "
+             "occull scenes --list-maps FILE.pk3 lists the maps of an archive.\n"
+             "file:MODEL — any model assimp reads (glTF 2, OBJ, ...); paths orbit, through.\n"
+             "Any scene also takes --path file:PATH, a recorded path (see occull path).\n");
   return 0;
 }
 
@@ -278,7 +306,7 @@ int cmd_render(const RenderArgs& a) {
   ropts.width = size.width;
   ropts.height = size.height;
   occull::Session session(a.scene, ropts);
-  const auto& path = a.path.empty() ? session.bundle().paths.front() : session.bundle().path(a.path);
+  const auto& path = session.path(a.path);
   auto culler = occull::make_culler(a.algo, session.index(), options);
   // Run the frames before K too, so cullers with temporal state see the
   // same history they would in a benchmark.
@@ -303,7 +331,14 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
 
   app.add_subcommand("info", "GL vendor, renderer, version, query counter bits, culling extensions");
-  app.add_subcommand("scenes", "embedded scenes: parameters, camera paths, object and triangle counts");
+  std::string list_maps;
+  auto* sc = app.add_subcommand("scenes", "embedded scenes: parameters, camera paths, object and triangle counts");
+  sc->add_option("--list-maps", list_maps, "list the Quake 3 maps inside a .pk3 archive");
+  PathArgs path_args;
+  auto* pa = app.add_subcommand("path", "write a scene's camera path to a text file (edit it, replay it with --path file:F)");
+  pa->add_option("--scene", path_args.scene, "scene spec")->capture_default_str();
+  pa->add_option("--path", path_args.path, "camera path (default: the scene's first)");
+  pa->add_option("--out", path_args.out, "output file")->required();
   app.add_subcommand("algos", "culling algorithms and their options (--opt algo.key=value)");
 
   BenchArgs bench;
@@ -366,7 +401,8 @@ int main(int argc, char** argv) {
   try {
     const std::string cmd = app.get_subcommands().front()->get_name();
     if (cmd == "info") return cmd_info();
-    if (cmd == "scenes") return cmd_scenes();
+    if (cmd == "scenes") return list_maps.empty() ? cmd_scenes() : cmd_list_maps(list_maps);
+    if (cmd == "path") return cmd_path(path_args);
     if (cmd == "algos") return cmd_algos();
     if (cmd == "bench") return cmd_bench(bench);
     if (cmd == "render") return cmd_render(render);

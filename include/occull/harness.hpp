@@ -113,6 +113,11 @@ class Session {
   /// rendered plus t_o of every query issued (milliseconds).
   [[nodiscard]] double predicted_frame_ms(const View& view);
 
+  /// The named camera path of the scene (empty: its first), or a recorded
+  /// one for "file:PATH" (read_path_file). Throws InputError listing the
+  /// valid names, or naming what is wrong in the file.
+  const CameraPath& path(std::string_view name);
+
   /// View of `path` at frame k of `frames`.
   [[nodiscard]] View view_at(const CameraPath& path, int k, int frames) const;
 

@@ -44,7 +44,8 @@ struct SceneBundle {
 [[nodiscard]] std::span<const SceneInfo> embedded_scenes();
 
 /// Builds a scene from a spec "name[:key=value[,key=value...]]", e.g.
-/// "city:blocks=6,seed=3". Throws InputError for an unknown scene (listing
+/// "city:blocks=6,seed=3"; or loads one: "q3:FILE.pk3:MAP" or "q3:FILE.bsp"
+/// (a Quake 3 level, occull/q3bsp.hpp), "file:MODEL" (anything assimp reads). Throws InputError for an unknown scene (listing
 /// the valid ones), an unknown parameter (listing that scene's) or a value
 /// out of range.
 [[nodiscard]] SceneBundle make_scene(std::string_view spec);

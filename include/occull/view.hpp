@@ -76,4 +76,16 @@ class CameraPath {
   std::vector<Key> keys_;
 };
 
+/// Reads a recorded camera path: a text file with one pose per line,
+/// "time x y z yaw pitch" (seconds, scene units, degrees; yaw turns about
+/// +Y, 0 looks down -Z; pitch looks up when positive), optionally followed
+/// by the word "cut" to jump to that pose. Blank lines and lines starting
+/// with '#' are skipped. The path is named "file:" + the file name.
+/// Throws InputError naming the file and line of anything malformed.
+[[nodiscard]] CameraPath read_path_file(const std::string& file);
+
+/// Writes a path in the format read_path_file reads. Throws InputError when
+/// the file cannot be written.
+void write_path_file(const CameraPath& path, const std::string& file);
+
 }  // namespace occull

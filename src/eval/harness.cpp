@@ -84,6 +84,18 @@ Session::~Session() {
   context_.reset();
 }
 
+const CameraPath& Session::path(std::string_view name) {
+  if (name.empty()) return bundle_.paths.front();
+  if (name.rfind("file:", 0) == 0) {
+    CameraPath p = read_path_file(std::string(name.substr(5)));
+    for (const CameraPath& known : bundle_.paths)
+      if (known.name() == p.name()) return known;
+    bundle_.paths.push_back(std::move(p));
+    return bundle_.paths.back();
+  }
+  return bundle_.path(name);
+}
+
 View Session::view_at(const CameraPath& path, int k, int frames) const {
   return make_view(path.sample(path.frame_time(k, frames)), bundle_.lens, renderer_->width(),
                    renderer_->height());
@@ -358,8 +370,7 @@ BenchResult run_bench(const BenchConfig& config, const ProgressFn& progress) {
   ropts.write_ids = false;  // timed frames draw colour and depth only
   ropts.multi_draw = config.multi_draw;
   Session session(config.scene, ropts, config.bvh);
-  const CameraPath& path = config.path.empty() ? session.bundle().paths.front()
-                                               : session.bundle().path(config.path);
+  const CameraPath& path = session.path(config.path);
   for (const auto& n : names) (void)session.make(n, config.options);  // options of each, early
   if (config.model) (void)session.hardware_profile([&](const std::string& line) {
     if (progress) progress(line, 0, 1, true);

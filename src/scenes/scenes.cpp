@@ -1,5 +1,7 @@
 // Registry of the embedded scenes and parsing of scene specs.
 #include "occull/error.hpp"
+#include "model_file.hpp"
+#include "occull/q3bsp.hpp"
 #include "scenes_internal.hpp"
 
 #include <fmt/format.h>
@@ -70,13 +72,17 @@ const CameraPath& SceneBundle::path(std::string_view name) const {
 }
 
 SceneBundle make_scene(std::string_view spec) {
+  if (spec.rfind("q3:", 0) == 0) return q3::load(spec.substr(3));
+  if (spec.rfind("file:", 0) == 0) return scenes::load_model_file(std::string(spec.substr(5)));
   const auto colon = spec.find(':');
   const std::string_view name = spec.substr(0, colon);
   const Generator* gen = nullptr;
   for (const auto& g : generators())
     if (g.info.name == name) gen = &g;
   if (!gen)
-    throw InputError(fmt::format("unknown scene '{}'; valid scenes: {}", name, scene_names()));
+    throw InputError(fmt::format("unknown scene '{}'; valid scenes: {} (or q3:FILE.pk3:MAP, q3:FILE.bsp, "
+                                 "file:MODEL)",
+                                 name, scene_names()));
 
   scenes::Params params;
   for (const auto& p : gen->info.params) params[p.key] = p.default_value;

@@ -1,0 +1,120 @@
+// `file:PATH` scenes: any model assimp reads (glTF 2, OBJ, ...). Every mesh
+// node becomes objects in world space, meshes larger than a culling-sized
+// piece split by spatial clustering; camera paths `orbit` and `through`.
+#include "model_file.hpp"
+
+#include "occull/error.hpp"
+#include "triangle_soup.hpp"
+
+#include <assimp/Importer.hpp>
+#include <assimp/postprocess.h>
+#include <assimp/scene.h>
+#include <fmt/format.h>
+#include <glm/gtc/constants.hpp>
+
+#include <cmath>
+#include <filesystem>
+
+namespace occull::scenes {
+namespace {
+
+glm::mat4 to_glm(const aiMatrix4x4& m) {
+  // assimp is row-major, glm column-major.
+  return glm::mat4(m.a1, m.b1, m.c1, m.d1, m.a2, m.b2, m.c2, m.d2, m.a3, m.b3, m.c3, m.d3, m.a4, m.b4,
+                   m.c4, m.d4);
+}
+
+void collect(const aiScene* s, const aiNode* node, const glm::mat4& parent, std::vector<SoupTriangle>& out) {
+  const glm::mat4 world = parent * to_glm(node->mTransformation);
+  const glm::mat3 normal_matrix = glm::transpose(glm::inverse(glm::mat3(world)));
+  for (unsigned k = 0; k < node->mNumMeshes; ++k) {
+    const aiMesh* mesh = s->mMeshes[node->mMeshes[k]];
+    if (!(mesh->mPrimitiveTypes & aiPrimitiveType_TRIANGLE)) continue;
+    for (unsigned f = 0; f < mesh->mNumFaces; ++f) {
+      const aiFace& face = mesh->mFaces[f];
+      if (face.mNumIndices != 3) continue;
+      SoupTriangle t;
+      t.material = std::int32_t(mesh->mMaterialIndex);
+      for (int c = 0; c < 3; ++c) {
+        const unsigned i = face.mIndices[c];
+        if (i >= mesh->mNumVertices) continue;
+        const aiVector3D& p = mesh->mVertices[i];
+        t.p[c] = glm::vec3(world * glm::vec4(p.x, p.y, p.z, 1.0f));
+        const aiVector3D n = mesh->mNormals ? mesh->mNormals[i] : aiVector3D(0, 1, 0);
+        t.n[c] = normal_matrix * glm::vec3(n.x, n.y, n.z);
+      }
+      const glm::vec3 g = glm::cross(t.p[1] - t.p[0], t.p[2] - t.p[0]);
+      if (glm::dot(g, g) > 0.0f) out.push_back(t);
+    }
+  }
+  for (unsigned c = 0; c < node->mNumChildren; ++c) collect(s, node->mChildren[c], world, out);
+}
+
+}  // namespace
+
+SceneBundle load_model_file(const std::string& path, std::uint32_t object_triangles) {
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec))
+    throw InputError(fmt::format("{}: no such file", path));
+  Assimp::Importer importer;
+  const aiScene* s = importer.ReadFile(path, aiProcess_Triangulate | aiProcess_GenSmoothNormals |
+                                                 aiProcess_JoinIdenticalVertices | aiProcess_SortByPType);
+  if (!s || !s->mRootNode || (s->mFlags & AI_SCENE_FLAGS_INCOMPLETE))
+    throw InputError(fmt::format("{}: cannot be read as a model ({})", path, importer.GetErrorString()));
+
+  std::vector<SoupTriangle> tris;
+  collect(s, s->mRootNode, glm::mat4(1.0f), tris);
+  if (tris.empty()) throw InputError(fmt::format("{}: has no triangles", path));
+
+  const std::string name = std::filesystem::path(path).filename().string();
+  SceneBundle bundle{Scene("file:" + name), {}, Lens{}};
+  Scene& scene = bundle.scene;
+  std::vector<MaterialId> materials;
+  for (unsigned m = 0; m < std::max(1u, s->mNumMaterials); ++m) {
+    aiColor4D diffuse(0.7f, 0.7f, 0.7f, 1.0f);
+    float opacity = 1.0f;
+    aiString mname("material");
+    if (m < s->mNumMaterials) {
+      s->mMaterials[m]->Get(AI_MATKEY_COLOR_DIFFUSE, diffuse);
+      s->mMaterials[m]->Get(AI_MATKEY_OPACITY, opacity);
+      s->mMaterials[m]->Get(AI_MATKEY_NAME, mname);
+    }
+    const bool translucent = opacity < 0.99f;
+    materials.push_back(scene.add_material({mname.C_Str(), {diffuse.r, diffuse.g, diffuse.b, translucent ? opacity : 1.0f},
+                                            translucent, 0}));
+  }
+  std::vector<std::pair<std::size_t, std::size_t>> groups;
+  // Cluster per material, so objects keep their own colour.
+  std::stable_sort(tris.begin(), tris.end(), [](const SoupTriangle& a, const SoupTriangle& b) { return a.material < b.material; });
+  for (std::size_t begin = 0; begin < tris.size();) {
+    std::size_t end = begin;
+    while (end < tris.size() && tris[end].material == tris[begin].material) ++end;
+    cluster_triangles(tris, begin, end, std::max<std::uint32_t>(object_triangles, 16), groups);
+    begin = end;
+  }
+  for (const auto& [begin, end] : groups) {
+    auto [mesh, material] = mesh_of(tris, begin, end);
+    const MaterialId m = materials[std::size_t(std::min<std::int32_t>(material, std::int32_t(materials.size()) - 1))];
+    scene.add_object(scene.add_mesh(std::move(mesh)), m, glm::mat4(1.0f),
+                     scene.material(m).translucent ? OccluderClass::never : OccluderClass::always);
+  }
+
+  const Aabb box = scene.bounds();
+  const glm::vec3 c = box.center();
+  const float radius = std::max(0.5f * glm::length(box.extent()), 1e-3f);
+  bundle.lens = Lens{60.0f, radius * 1e-3f, radius * 20.0f};
+  std::vector<CameraPath::Key> orbit;
+  for (int k = 0; k <= 16; ++k) {
+    const float a = glm::two_pi<float>() * float(k) / 16.0f;
+    const glm::vec3 eye = c + glm::vec3(1.6f * radius * std::sin(a), 0.45f * radius, 1.6f * radius * std::cos(a));
+    const glm::vec3 d = c - eye;
+    orbit.push_back({1.0 * k, {eye, std::atan2(-d.x, -d.z), std::atan2(d.y, std::hypot(d.x, d.z))}, false});
+  }
+  bundle.paths.emplace_back("orbit", "circles the model at 1.6 radii, looking at its centre", std::move(orbit));
+  bundle.paths.emplace_back("through", "flies straight through the middle of the model",
+                            std::vector<CameraPath::Key>{{0.0, {c + glm::vec3(0, 0, 1.5f * radius), 0.0f, 0.0f}, false},
+                                                         {8.0, {c - glm::vec3(0, 0, 1.5f * radius), 0.0f, 0.0f}, false}});
+  return bundle;
+}
+
+}  // namespace occull::scenes
