@@ -12,8 +12,6 @@ packages=(
   # libraries
   libglm-dev libfmt-dev libcli11-dev nlohmann-json3-dev libstb-dev libtinyxml2-dev
   libminizip-dev libassimp-dev
-  # fetching the OpenArena maps (make data)
-  dpkg-dev
   # tests and benchmarks
   libgtest-dev libgmock-dev libbenchmark-dev
 )
