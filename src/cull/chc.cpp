@@ -32,10 +32,7 @@ class ChcCuller final : public Culler {
   FrameStats render_frame(const View& view, Backend& backend) override {
     ++frame_;
     if (state_.size() != index_.bvh.size()) state_.assign(index_.bvh.size(), NodeState{});
-    stats_ = {};
-    view_ = &view;
-    backend_ = &backend;
-    radius_ = near_plane_radius(view);
+    f_.begin(view, backend);
 
     queue_.push(index_.bvh, Bvh::root(), view.eye);
     while (!queue_.empty() || !queries_.empty()) {
@@ -47,7 +44,7 @@ class ChcCuller final : public Culler {
       }
       if (queue_.empty()) continue;
       const NodeId n = queue_.pop();
-      ++stats_.nodes_visited;
+      ++f_.stats.nodes_visited;
       NodeState& s = state_[n];
       const bool previously_visible = was_visible(s, frame_);
       s.visible = false;  // invisible until shown otherwise
@@ -55,7 +52,7 @@ class ChcCuller final : public Culler {
       const BvhNode& node = index_.bvh.node(n);
       if (node.object_count == 0 || view.frustum.classify(node.bounds) == Containment::outside)
         continue;
-      if (near_eye(node.bounds, view, radius_)) {
+      if (near_eye(node.bounds, view, f_.near_radius)) {
         pull_up_visibility(state_, index_.bvh, n);
         traverse(n);
         continue;
@@ -72,7 +69,7 @@ class ChcCuller final : public Culler {
         traverse(n);
       }
     }
-    return stats_;
+    return f_.stats;
   }
 
  private:
@@ -87,8 +84,8 @@ class ChcCuller final : public Culler {
   void query(NodeId n, bool previously_visible) {
     boxes_.clear();
     append_query_boxes(index_, n, {}, boxes_);
-    queries_.push_back({backend_->issue_query(boxes_), n, previously_visible});
-    ++stats_.query_batches;
+    queries_.push_back({f_.backend->issue_query(boxes_), n, previously_visible});
+    ++f_.stats.query_batches;
   }
 
   void handle_returned_query(const Pending& p, std::uint64_t samples) {
@@ -101,11 +98,11 @@ class ChcCuller final : public Culler {
   void traverse(NodeId n) {
     if (is_leaf(n)) {
       objects_.clear();
-      append_objects_in_frustum(index_, n, *view_, objects_);
-      if (!objects_.empty()) backend_->render(objects_);
+      append_objects_in_frustum(index_, n, *f_.view, objects_);
+      if (!objects_.empty()) f_.backend->render(objects_);
     } else {
-      queue_.push(index_.bvh, Bvh::left(n), view_->eye);
-      queue_.push(index_.bvh, index_.bvh.right(n), view_->eye);
+      queue_.push(index_.bvh, Bvh::left(n), f_.view->eye);
+      queue_.push(index_.bvh, index_.bvh.right(n), f_.view->eye);
     }
   }
 
@@ -116,10 +113,7 @@ class ChcCuller final : public Culler {
   std::uint32_t frame_ = 0;
 
   // Per frame.
-  FrameStats stats_;
-  const View* view_ = nullptr;
-  Backend* backend_ = nullptr;
-  float radius_ = 0.0f;
+  FrameContext f_;
   DistanceQueue queue_;
   std::deque<Pending> queries_;
   std::vector<Aabb> boxes_;

@@ -112,10 +112,7 @@ class ChcppCuller final : public Culler {
   FrameStats render_frame(const View& view, Backend& backend) override {
     ++frame_;
     if (state_.size() != index_.bvh.size()) state_.assign(index_.bvh.size(), NodeState{});
-    stats_ = {};
-    view_ = &view;
-    backend_ = &backend;
-    radius_ = near_plane_radius(view);
+    f_.begin(view, backend);
 
     distance_queue_.push(index_.bvh, Bvh::root(), view.eye);
     while (!distance_queue_.empty() || !query_queue_.empty() || !i_queue_.empty()) {
@@ -135,7 +132,7 @@ class ChcppCuller final : public Culler {
     // One last batch for the visible leaves not queried yet, then their results.
     if (!v_queue_.empty()) {
       flush_render_queue();
-      ++stats_.query_batches;
+      ++f_.stats.query_batches;
       while (!v_queue_.empty()) {
         const NodeId n = v_queue_.front();
         v_queue_.pop_front();
@@ -144,7 +141,7 @@ class ChcppCuller final : public Culler {
     }
     flush_render_queue();
     while (!query_queue_.empty()) handle_returned_query();
-    return stats_;
+    return f_.stats;
   }
 
  private:
@@ -161,16 +158,16 @@ class ChcppCuller final : public Culler {
   bool is_leaf(NodeId n) const { return index_.bvh.is_leaf(n, config_.common.virtual_leaf_triangles); }
 
   void process_node(NodeId n) {
-    ++stats_.nodes_visited;
+    ++f_.stats.nodes_visited;
     NodeState& s = state_[n];
     const bool previously_visible = was_visible(s, frame_);
     s.visible = false;  // invisible by default
     s.last_visited = frame_;
     if (previously_visible) s.invisible_tests = 0;  // if invisible now, its persistence starts over
     const BvhNode& node = index_.bvh.node(n);
-    if (node.object_count == 0 || view_->frustum.classify(node.bounds) == Containment::outside)
+    if (node.object_count == 0 || f_.view->frustum.classify(node.bounds) == Containment::outside)
       return;
-    if (near_eye(node.bounds, *view_, radius_)) {
+    if (near_eye(node.bounds, *f_.view, f_.near_radius)) {
       pull_up_visibility(state_, index_.bvh, n);
       traverse(n);
       return;
@@ -186,7 +183,7 @@ class ChcppCuller final : public Culler {
           v_queue_.push_back(n);
         } else {
           flush_render_queue();  // CHC order: query the leaf, then render it
-          ++stats_.query_batches;
+          ++f_.stats.query_batches;
           issue({n}, true);
         }
       } else {
@@ -198,21 +195,21 @@ class ChcppCuller final : public Culler {
 
   void traverse(NodeId n) {
     if (is_leaf(n)) {
-      append_objects_in_frustum(index_, n, *view_, render_queue_);
+      append_objects_in_frustum(index_, n, *f_.view, render_queue_);
       render_queue_triangles_ += index_.bvh.node(n).triangles;
       if (config_.render_batch_triangles > 0 && render_queue_triangles_ >= config_.render_batch_triangles) {
         flush_render_queue();
-        if (config_.flush_batches) backend_->flush();
+        if (config_.flush_batches) f_.backend->flush();
       }
     } else {
-      distance_queue_.push(index_.bvh, Bvh::left(n), view_->eye);
-      distance_queue_.push(index_.bvh, index_.bvh.right(n), view_->eye);
+      distance_queue_.push(index_.bvh, Bvh::left(n), f_.view->eye);
+      distance_queue_.push(index_.bvh, index_.bvh.right(n), f_.view->eye);
     }
   }
 
   void flush_render_queue() {
     if (render_queue_.empty()) return;
-    backend_->render(render_queue_);
+    f_.backend->render(render_queue_);
     render_queue_.clear();
     render_queue_triangles_ = 0;
   }
@@ -220,13 +217,13 @@ class ChcppCuller final : public Culler {
   void issue(std::vector<NodeId> nodes, bool previously_visible) {
     boxes_.clear();
     for (NodeId n : nodes) append_query_boxes(index_, n, config_.shape, boxes_);
-    if (nodes.size() > 1) ++stats_.multiqueries;
-    query_queue_.push_back({backend_->issue_query(boxes_), std::move(nodes), previously_visible});
+    if (nodes.size() > 1) ++f_.stats.multiqueries;
+    query_queue_.push_back({f_.backend->issue_query(boxes_), std::move(nodes), previously_visible});
   }
 
   void issue_v_query() {
     flush_render_queue();
-    ++stats_.query_batches;
+    ++f_.stats.query_batches;
     const NodeId n = v_queue_.front();
     v_queue_.pop_front();
     issue({n}, true);
@@ -237,7 +234,7 @@ class ChcppCuller final : public Culler {
   void issue_multiqueries() {
     if (i_queue_.empty()) return;
     flush_render_queue();
-    ++stats_.query_batches;
+    ++f_.stats.query_batches;
     std::vector<Invisible> grouped;
     for (const Invisible& e : i_queue_) {
       if (e.single || !config_.multiquery)
@@ -263,13 +260,13 @@ class ChcppCuller final : public Culler {
       issue(std::move(nodes), false);
       begin += size;
     }
-    if (config_.flush_batches) backend_->flush();
+    if (config_.flush_batches) f_.backend->flush();
   }
 
   void handle_returned_query() {
     Pending q = std::move(query_queue_.front());
     query_queue_.pop_front();
-    const bool visible = backend_->result(q.id) > config_.common.threshold;
+    const bool visible = f_.backend->result(q.id) > config_.common.threshold;
     if (q.previously_visible) {  // a v-queue query: classification for the next frame
       const NodeId n = q.nodes.front();
       if (visible) {
@@ -281,7 +278,7 @@ class ChcppCuller final : public Culler {
       return;
     }
     if (visible && q.nodes.size() > 1) {  // failed multiquery: query each node alone
-      ++stats_.failed_multiqueries;
+      ++f_.stats.failed_multiqueries;
       for (NodeId n : q.nodes) i_queue_.push_back({n, true});
       return;
     }
@@ -309,10 +306,7 @@ class ChcppCuller final : public Culler {
   std::uint64_t random_;
 
   // Per frame.
-  FrameStats stats_;
-  const View* view_ = nullptr;
-  Backend* backend_ = nullptr;
-  float radius_ = 0.0f;
+  FrameContext f_;
   DistanceQueue distance_queue_;
   std::deque<Pending> query_queue_;
   std::vector<Invisible> i_queue_;

@@ -93,10 +93,7 @@ class NohcCuller final : public Culler {
   FrameStats render_frame(const View& view, Backend& backend) override {
     ++frame_;
     if (nodes_.size() != index_.bvh.size()) nodes_.assign(index_.bvh.size(), NodeInfo{});
-    stats_ = {};
-    view_ = &view;
-    backend_ = &backend;
-    radius_ = near_plane_radius(view);
+    f_.begin(view, backend);
     fov_y_ = 2.0 * std::atan(1.0 / double(view.proj[1][1]));
     c_scr_ = 0.0;
 
@@ -115,7 +112,7 @@ class NohcCuller final : public Culler {
       visit(n);
     }
     flush_render_queue();
-    return stats_;
+    return f_.stats;
   }
 
  private:
@@ -155,11 +152,11 @@ class NohcCuller final : public Culler {
     if (i.cost_frame != frame_) {
       const Aabb& box = index_.bvh.node(n).bounds;
       if (config_.exact_area) {
-        i.c_bb = projected_area(box, view_->view_proj, view_->width, view_->height) /
-                 (double(view_->width) * double(view_->height));
+        i.c_bb = projected_area(box, f_.view->view_proj, f_.view->width, f_.view->height) /
+                 (double(f_.view->width) * double(f_.view->height));
       } else {
-        i.c_bb = bbox_screen_fraction(box.surface_area(), distance(view_->eye, box), view_->width,
-                                      view_->height, fov_y_);
+        i.c_bb = bbox_screen_fraction(box.surface_area(), distance(f_.view->eye, box), f_.view->width,
+                                      f_.view->height, fov_y_);
       }
       i.cost_frame = frame_;
     }
@@ -175,8 +172,8 @@ class NohcCuller final : public Culler {
     cost.c_bb = c_bb(n);
     cost.r_cov = coverage_ratio(nodes_[n].area, node.bounds.surface_area());
     NodeEstimate e;
-    e.t_r = render_time(hw_, cost, view_->width, view_->height, config_.fragments_per_pixel);
-    e.t_o = query_time(hw_, cost.c_bb, view_->width, view_->height);
+    e.t_r = render_time(hw_, cost, f_.view->width, f_.view->height, config_.fragments_per_pixel);
+    e.t_o = query_time(hw_, cost.c_bb, f_.view->width, f_.view->height);
     double p = occlusion_probability(previous_state(n), coverage_probability(c_scr_, cost.c_bb));
     if (previous_state(n) == PreviousState::visible) p *= config_.visible_factor / 0.5;
     e.p_occl = std::clamp(p, 0.0, 1.0);
@@ -185,16 +182,16 @@ class NohcCuller final : public Culler {
   }
 
   void visit(NodeId n) {
-    ++stats_.nodes_visited;
+    ++f_.stats.nodes_visited;
     NodeInfo& info = nodes_[n];
     const PreviousState previous = previous_state(n);
     info.visible = false;
     info.last_visited = frame_;
     info.state = PreviousState::outside;
     const BvhNode& node = index_.bvh.node(n);
-    if (node.object_count == 0 || view_->frustum.classify(node.bounds) == Containment::outside) return;
+    if (node.object_count == 0 || f_.view->frustum.classify(node.bounds) == Containment::outside) return;
     info.state = PreviousState::visible;  // until a query says otherwise
-    if (near_eye(node.bounds, *view_, radius_)) {
+    if (near_eye(node.bounds, *f_.view, f_.near_radius)) {
       process(n);
       return;
     }
@@ -215,8 +212,8 @@ class NohcCuller final : public Culler {
       boxes_.clear();
       append_query_boxes(index_, n, {}, boxes_);
       const bool wait = previous == PreviousState::occluded;
-      query_queue_.push_back({backend_->issue_query(boxes_), n, wait});
-      ++stats_.query_batches;
+      query_queue_.push_back({f_.backend->issue_query(boxes_), n, wait});
+      ++f_.stats.query_batches;
       info.frames_since_query = 0;
       if (!wait) process(n);
     } else {
@@ -229,7 +226,7 @@ class NohcCuller final : public Culler {
   // then prefers querying the children).
   NodeEstimate child_estimate(NodeId c) {
     if (index_.bvh.node(c).object_count == 0 ||
-        view_->frustum.classify(index_.bvh.node(c).bounds) == Containment::outside)
+        f_.view->frustum.classify(index_.bvh.node(c).bounds) == Containment::outside)
       return {0.0, 0.0, 0.0, 0};
     return estimate(c);
   }
@@ -237,7 +234,7 @@ class NohcCuller final : public Culler {
   void process(NodeId n) {
     if (is_leaf(n)) {
       const std::size_t before = render_queue_.size();
-      append_objects_in_frustum(index_, n, *view_, render_queue_);
+      append_objects_in_frustum(index_, n, *f_.view, render_queue_);
       if (render_queue_.size() > before) {
         NodeCost cost;
         cost.c_bb = c_bb(n);
@@ -246,8 +243,8 @@ class NohcCuller final : public Culler {
       }
       pull_up(n);
     } else {
-      distance_queue_.push(index_.bvh, Bvh::left(n), view_->eye);
-      distance_queue_.push(index_.bvh, index_.bvh.right(n), view_->eye);
+      distance_queue_.push(index_.bvh, Bvh::left(n), f_.view->eye);
+      distance_queue_.push(index_.bvh, index_.bvh.right(n), f_.view->eye);
     }
   }
 
@@ -260,13 +257,13 @@ class NohcCuller final : public Culler {
 
   bool first_query_finished() {
     if (int(query_queue_.size()) >= max_parallel_) return true;  // the N_q rule
-    return backend_->result_available(query_queue_.front().id);
+    return f_.backend->result_available(query_queue_.front().id);
   }
 
   void handle_returned_query() {
     const Pending q = query_queue_.front();
     query_queue_.pop_front();
-    const bool visible = backend_->result(q.id) > config_.threshold;
+    const bool visible = f_.backend->result(q.id) > config_.threshold;
     if (cancelled(q.node)) return;  // an ancestor is occluded: nothing to do
     NodeInfo& info = nodes_[q.node];
     if (visible) {
@@ -281,7 +278,7 @@ class NohcCuller final : public Culler {
 
   void flush_render_queue() {
     if (render_queue_.empty()) return;
-    backend_->render(render_queue_);
+    f_.backend->render(render_queue_);
     render_queue_.clear();
   }
 
@@ -294,10 +291,7 @@ class NohcCuller final : public Culler {
   std::uint32_t frame_ = 0;
 
   // Per frame.
-  FrameStats stats_;
-  const View* view_ = nullptr;
-  Backend* backend_ = nullptr;
-  float radius_ = 0.0f;
+  FrameContext f_;
   double fov_y_ = 1.0;
   double c_scr_ = 0.0;
   DistanceQueue distance_queue_;

@@ -45,6 +45,22 @@ inline std::array<NodeId, 2> children_front_to_back(const Bvh& bvh, NodeId n, co
   return {l, r};
 }
 
+/// What a hierarchical culler knows during one frame: its counters, the
+/// view and the backend, and the near-plane radius of the eye-inside rule.
+struct FrameContext {
+  FrameStats stats;
+  const View* view = nullptr;
+  Backend* backend = nullptr;
+  float near_radius = 0.0f;
+
+  void begin(const View& v, Backend& b) {
+    stats = {};
+    view = &v;
+    backend = &b;
+    near_radius = near_plane_radius(v);
+  }
+};
+
 /// Traversal queue ordered by distance from the eye to the node's box,
 /// nearest first (ties: lower node id first, so traversal is deterministic).
 class DistanceQueue {
