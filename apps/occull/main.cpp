@@ -345,7 +345,7 @@ int main(int argc, char** argv) {
   auto* b = app.add_subcommand("bench", "fly a camera path with each algorithm and report frame times");
   b->add_option("--scene", bench.scene, "scene spec name[:key=value,...] (see occull scenes)")
       ->capture_default_str();
-  b->add_option("--path", bench.path, "camera path (default: the scene's first)");
+  b->add_option("--path", bench.path, "camera path (default: the scene's first), or file:PATH to replay a recorded one");
   b->add_option("--algo", bench.algos,
                 "comma-separated algorithms, each optionally with its own options as "
                 "name:key=value:key=value (default: all; see occull algos)");
@@ -382,7 +382,7 @@ int main(int argc, char** argv) {
   RenderArgs render;
   auto* r = app.add_subcommand("render", "render one frame of a path with an algorithm to a PNG");
   r->add_option("--scene", render.scene, "scene spec name[:key=value,...]")->capture_default_str();
-  r->add_option("--path", render.path, "camera path (default: the scene's first)");
+  r->add_option("--path", render.path, "camera path (default: the scene's first), or file:PATH");
   r->add_option("--algo", render.algo, "algorithm")->capture_default_str();
   r->add_option("--frame", render.frame, "frame index K (0-based) of --frames along the path")
       ->capture_default_str();
