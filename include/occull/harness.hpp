@@ -95,6 +95,11 @@ class Session {
 
   /// Runs `culler` over frames 0..frames-1 of `path`. With `truth` (one
   /// entry per frame), verifies every frame; the oracle needs it.
+  /// Runs frame k of `frames` along `path` (feeding the oracle that
+  /// frame's truth; it needs `truth`). Timings as run_frame.
+  FrameStats run_path_frame(Culler& culler, const CameraPath& path, int k, int frames,
+                            const std::vector<FrameTruth>* truth);
+
   /// With `predict`, also fills FrameStats::model_ms (see predicted_frame_ms).
   AlgorithmRun run_path(std::string_view name, Culler& culler, const CameraPath& path, int frames,
                         const std::vector<FrameTruth>* truth, const ProgressFn& progress = {},

@@ -208,25 +208,28 @@ double Session::predicted_frame_ms(const View& view) {
   return ms;
 }
 
+FrameStats Session::run_path_frame(Culler& culler, const CameraPath& path, int k, int frames,
+                                   const std::vector<FrameTruth>* truth) {
+  if (auto* oracle = dynamic_cast<detail::OracleCuller*>(&culler)) {
+    if (!truth) throw InputError("the oracle needs ground truth: run it with verification on");
+    std::vector<ObjectId> visible;
+    visible.reserve((*truth)[std::size_t(k)].size());
+    for (const auto& t : (*truth)[std::size_t(k)]) visible.push_back(t.id);
+    oracle->set_visible(std::move(visible));
+  }
+  return run_frame(culler, view_at(path, k, frames), path.frame_time(k, frames));
+}
+
 AlgorithmRun Session::run_path(std::string_view name, Culler& culler, const CameraPath& path,
                                int frames, const std::vector<FrameTruth>* truth,
                                const ProgressFn& progress, bool predict) {
-  auto* oracle = dynamic_cast<detail::OracleCuller*>(&culler);
-  if (oracle && !truth) throw InputError("the oracle needs ground truth: run it with verification on");
   AlgorithmRun run{std::string(name), 0, {}, 0};
   run.frames.reserve(std::size_t(frames));
   std::vector<std::uint32_t> miss_run(bundle_.scene.objects().size(), 0);
   std::vector<ObjectId> previously_missed;
   for (int k = 0; k < frames; ++k) {
-    if (oracle) {
-      std::vector<ObjectId> visible;
-      visible.reserve((*truth)[std::size_t(k)].size());
-      for (const auto& t : (*truth)[std::size_t(k)]) visible.push_back(t.id);
-      oracle->set_visible(std::move(visible));
-    }
-    const View view = view_at(path, k, frames);
-    FrameStats s = run_frame(culler, view, path.frame_time(k, frames));
-    if (predict) s.model_ms = predicted_frame_ms(view);
+    FrameStats s = run_path_frame(culler, path, k, frames, truth);
+    if (predict) s.model_ms = predicted_frame_ms(view_at(path, k, frames));
     if (truth) {
       // Outside the timed region: compare what was rendered with the truth.
       const std::vector<ObjectId> missed =
@@ -407,16 +410,9 @@ BenchResult run_bench(const BenchConfig& config, const ProgressFn& progress) {
       session.reset_renderer();
       {
         auto warm = session.make(name, config.options);
-        auto* oracle = dynamic_cast<detail::OracleCuller*>(warm.get());
         for (int k = 0; k < config.warmup; ++k) {
           const int f = config.warmup > 1 ? k * (config.frames - 1) / (config.warmup - 1) : 0;
-          if (oracle) {
-            std::vector<ObjectId> visible;
-            for (const auto& t : truth[std::size_t(f)]) visible.push_back(t.id);
-            oracle->set_visible(std::move(visible));
-          }
-          session.run_frame(*warm, session.view_at(path, f, config.frames),
-                            path.frame_time(f, config.frames));
+          (void)session.run_path_frame(*warm, path, f, config.frames, truth_ptr);
           if (progress) progress(label, k, config.warmup, true);
         }
       }
