@@ -3,6 +3,7 @@
 // with moving cars, and on a path that walks through object boxes.
 #include "occull/error.hpp"
 #include "occull/harness.hpp"
+#include "gl_test_util.hpp"
 
 #include <gtest/gtest.h>
 
@@ -18,13 +19,7 @@ const char* const kConservative[] = {
     "stopwait", "chc", "chc:skip=4", "chcpp", "chcpp:batch=1", "chcpp:vqueue=off",
     "chcpp:multiquery=off", "chcpp:jitter=off", "chcpp:tight=off", "chcpp:virtual_leaf=0", "nohc"};
 
-gl::RendererOptions small_target() {
-  gl::RendererOptions o;
-  o.width = 192;
-  o.height = 108;
-  o.write_ids = false;
-  return o;
-}
+gl::RendererOptions small_target() { return test::small_target(192, 108); }
 
 void expect_no_misses(Session& session, const CameraPath& path, const std::string& where) {
   const auto truth = session.ground_truth(path, kFrames);

@@ -1,5 +1,6 @@
 // Ground truth, verification, the oracle and the report writers.
 #include "occull/harness.hpp"
+#include "gl_test_util.hpp"
 #include "occull/error.hpp"
 #include "occull/report.hpp"
 #include "test_util.hpp"
@@ -20,13 +21,7 @@ namespace {
 
 constexpr const char* kSmallCity = "city:blocks=3,traffic=6";
 
-gl::RendererOptions small_target() {
-  gl::RendererOptions o;
-  o.width = 160;
-  o.height = 90;
-  o.write_ids = false;
-  return o;
-}
+gl::RendererOptions small_target() { return test::small_target(160, 90); }
 
 // Renders what an inner culler renders, minus one object.
 class DroppingCuller final : public Culler {

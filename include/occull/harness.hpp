@@ -145,7 +145,6 @@ class Session {
   gl::RendererOptions renderer_options_;
   std::unique_ptr<gl::Renderer> renderer_;
   std::optional<HardwareProfile> profile_;
-  std::vector<double> mesh_area_;  // surface area per mesh, for the model
 };
 
 struct BenchConfig {

@@ -106,6 +106,9 @@ class Scene {
   [[nodiscard]] std::uint64_t triangle_count() const noexcept;
   /// Box of every object's bounds.
   [[nodiscard]] Aabb bounds() const noexcept;
+  /// World-space surface area of an object's triangles (its mesh's area
+  /// times the square of the transform's uniform scale), squared scene units.
+  [[nodiscard]] double object_surface_area(ObjectId id) const;
 
  private:
   std::string name_;
@@ -116,6 +119,7 @@ class Scene {
   std::vector<glm::mat4> dynamic_local_;  // per motion: local transform
   std::vector<ObjectId> dynamic_;
   std::vector<Aabb> mesh_bounds_;
+  std::vector<double> mesh_area_;
 };
 
 }  // namespace occull

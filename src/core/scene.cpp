@@ -51,6 +51,7 @@ glm::mat4 Motion::transform_at(double time_s) const {
 MeshId Scene::add_mesh(Mesh mesh) {
   assert(mesh.normals.size() == mesh.positions.size());
   mesh_bounds_.push_back(mesh.bounds());
+  mesh_area_.push_back(mesh.surface_area());
   meshes_.push_back(std::move(mesh));
   return MeshId(meshes_.size() - 1);
 }
@@ -97,6 +98,12 @@ std::uint64_t Scene::triangle_count() const noexcept {
   std::uint64_t n = 0;
   for (const auto& o : objects_) n += o.triangles;
   return n;
+}
+
+double Scene::object_surface_area(ObjectId id) const {
+  const Object& o = objects_[id];
+  const double scale = std::cbrt(std::abs(double(glm::determinant(glm::mat3(o.transform)))));
+  return mesh_area_[o.mesh] * scale * scale;
 }
 
 Aabb Scene::bounds() const noexcept {

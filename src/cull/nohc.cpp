@@ -80,8 +80,7 @@ class NohcCuller final : public Culler {
       double weighted = 0.0;
       for (ObjectId id : bvh.objects(n)) {
         const Object& o = index.scene.object(id);
-        const double scale = std::cbrt(std::abs(double(glm::determinant(glm::mat3(o.transform)))));
-        info.area += index.scene.mesh(o.mesh).surface_area() * scale * scale;
+        info.area += index.scene.object_surface_area(id);
         weighted += double(o.triangles) * double(index.scene.material(o.material).shading_cost);
       }
       info.shading = bvh.node(n).triangles > 0 ? weighted / double(bvh.node(n).triangles) : 0.0;

@@ -181,19 +181,16 @@ const HardwareProfile& Session::hardware_profile(const std::function<void(const 
 double Session::predicted_frame_ms(const View& view) {
   const HardwareProfile& hw = hardware_profile();
   const Scene& scene = bundle_.scene;
-  if (mesh_area_.empty())
-    for (const Mesh& m : scene.meshes()) mesh_area_.push_back(m.surface_area());
   const double pixels = double(view.width) * double(view.height);
   double ms = 0.0;
   for (ObjectId id : renderer_->frame_objects()) {
     const Object& o = scene.object(id);
-    const double scale = std::cbrt(std::abs(double(glm::determinant(glm::mat3(o.transform)))));
     NodeCost c;
     c.draws = 1;
     c.triangles = o.triangles;
     c.shading_cost = scene.material(o.material).shading_cost;
     c.c_bb = projected_area(o.bounds, view.view_proj, view.width, view.height) / pixels;
-    c.r_cov = coverage_ratio(mesh_area_[o.mesh] * scale * scale, o.bounds.surface_area());
+    c.r_cov = coverage_ratio(scene.object_surface_area(id), o.bounds.surface_area());
     ms += render_time(hw, c, view.width, view.height);
   }
   const auto boxes = renderer_->frame_query_boxes();
