@@ -295,3 +295,65 @@ TEST_F(RendererTest, QueryCountsEachVisiblePixelOnce) {
   const double area = projected_area(box[0], w.view.view_proj, kSize, kSize);
   EXPECT_NEAR(double(samples), area, 0.1 * area);
 }
+
+// GL state belongs to whoever draws: a second renderer in the same context
+// (as NOHC's calibration makes) binds its own buffers and, when destroyed,
+// deletes them — which unbinds whatever binding points they held. The first
+// renderer must establish its own state per frame and per pass.
+TEST_F(RendererTest, AnotherRendererInTheSameContextChangesNothing) {
+  WallScene w;
+  gl::Renderer a(w.scene, small());
+  const ObjectId all[] = {0, 1, 2};
+  const auto frame_of_a = [&] {
+    a.begin_frame(w.view);
+    a.render(all);
+    const Aabb hidden[] = {w.scene.object(WallScene::hidden).bounds};
+    EXPECT_EQ(a.result(a.issue_query(hidden)), 0u);
+    a.end_frame();
+    return std::make_pair(a.read_ids(), a.read_rgba());
+  };
+  const auto truth_before = a.visible_pixels(w.view, all);
+  const auto frame_before = frame_of_a();
+  ASSERT_EQ(truth_before.size(), 2u);
+  {
+    // Another scene, size, query target and culling mode, used then destroyed.
+    const Scene other = test::box_scene({{{-20, -20, -40}, {20, 20, -30}}});
+    gl::RendererOptions o;
+    o.width = 48;
+    o.height = 32;
+    o.query_mode = gl::QueryMode::any_samples_passed;
+    o.cull_backfaces = false;
+    o.multi_draw = true;
+    gl::Renderer b(other, o);
+    const View v = make_view({{0, 0, 0}, 0.3f, 0.1f}, {90.0f, 0.5f, 50.0f}, 48, 32);
+    b.begin_frame(v);
+    const ObjectId obj[] = {0};
+    b.render(obj);
+    const Aabb box[] = {other.object(0).bounds};
+    (void)b.result(b.issue_query(box));
+    b.end_frame();
+  }
+  EXPECT_EQ(a.visible_pixels(w.view, all), truth_before);
+  const auto frame_after = frame_of_a();
+  EXPECT_TRUE(frame_after.first == frame_before.first) << "id image changed";
+  EXPECT_TRUE(frame_after.second == frame_before.second) << "colour image changed";
+}
+
+// With back-face culling off, a closed box seen from inside shows its inner
+// faces — also after a query pass, which culls the back faces of its boxes.
+TEST_F(RendererTest, BackFacesStayDrawnAfterAQueryWhenCullingIsOff) {
+  const Scene scene = test::box_scene({{{-5, -5, -5}, {5, 5, 5}}});
+  gl::RendererOptions o = small();
+  o.cull_backfaces = false;
+  gl::Renderer r(scene, o);
+  const View view = make_view({{0, 0, 0}, 0, 0}, {60.0f, 0.1f, 100.0f}, kSize, kSize);
+  r.begin_frame(view);
+  const Aabb far_box[] = {{{-1, -1, -30}, {1, 1, -29}}};
+  (void)r.result(r.issue_query(far_box));
+  const ObjectId room[] = {0};
+  r.render(room);
+  r.end_frame();
+  const auto ids = r.read_ids();
+  EXPECT_EQ(std::count(ids.begin(), ids.end(), 1u), std::ptrdiff_t(ids.size()))
+      << "every pixel shows the inside of the box";
+}

@@ -131,6 +131,17 @@ struct DrawCommand {
 
 constexpr GLsizeiptr kBoxCapacity = 1 << 16;  // boxes per stream-buffer fill
 
+// State glReadPixels depends on: the framebuffer read from, no pixel-pack
+// buffer (else it writes into that buffer), tight rows.
+void bind_for_reading(GLuint fbo, GLint alignment) {
+  glBindFramebuffer(GL_READ_FRAMEBUFFER, fbo);
+  glBindBuffer(GL_PIXEL_PACK_BUFFER, 0);
+  glPixelStorei(GL_PACK_ALIGNMENT, alignment);
+  glPixelStorei(GL_PACK_ROW_LENGTH, 0);
+  glPixelStorei(GL_PACK_SKIP_ROWS, 0);
+  glPixelStorei(GL_PACK_SKIP_PIXELS, 0);
+}
+
 }  // namespace
 
 struct Renderer::Impl {
@@ -178,6 +189,7 @@ struct Renderer::Impl {
   void create_scene_buffers();
   void create_query_resources();
   void apply_draw_buffers() const;
+  void establish_frame_state() const;
   void enter_render_state(BackendStats& stats);
   void enter_query_state(BackendStats& stats);
   void draw_objects(std::span<const ObjectId> ids, BackendStats& stats);
@@ -334,6 +346,36 @@ void Renderer::Impl::create_query_resources() {
   glCreateQueries(GL_SAMPLES_PASSED, 1, &truth_query);
 }
 
+// Every piece of context state the renderer's passes rely on and that no
+// pass sets itself. Other GL code in the same context (another renderer,
+// an engine's own passes) may have changed any of it, and deleting a GL
+// object unbinds it from every binding point, so this runs at the start of
+// every frame — never only at construction.
+void Renderer::Impl::establish_frame_state() const {
+  glBindFramebuffer(GL_FRAMEBUFFER, fbo);
+  glViewport(0, 0, options.width, options.height);
+  glDepthRange(0.0, 1.0);
+  glClipControl(GL_LOWER_LEFT, GL_NEGATIVE_ONE_TO_ONE);
+  // Capabilities that would drop or alter fragments, clears or samples.
+  for (GLenum cap : {GL_SCISSOR_TEST, GL_STENCIL_TEST, GL_BLEND, GL_RASTERIZER_DISCARD,
+                     GL_COLOR_LOGIC_OP, GL_SAMPLE_ALPHA_TO_COVERAGE, GL_SAMPLE_COVERAGE,
+                     GL_SAMPLE_MASK, GL_FRAMEBUFFER_SRGB, GL_PRIMITIVE_RESTART,
+                     GL_PRIMITIVE_RESTART_FIXED_INDEX})
+    glDisable(cap);
+  for (GLenum i = 0; i < 8; ++i) glDisable(GL_CLIP_DISTANCE0 + i);  // shaders write none
+  glEnable(GL_DEPTH_TEST);
+  glPolygonMode(GL_FRONT_AND_BACK, GL_FILL);
+  glFrontFace(GL_CCW);
+  glCullFace(GL_BACK);
+  // Buffers read by the shaders, and targets that change what GL calls do:
+  // a bound query buffer makes glGetQueryObject write into it instead of
+  // returning the result.
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, object_buffer);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, material_buffer);
+  glBindBuffer(GL_QUERY_BUFFER, 0);
+  glBindBuffer(GL_DRAW_INDIRECT_BUFFER, indirect_buffer);
+}
+
 void Renderer::Impl::enter_render_state(BackendStats& stats) {
   if (mode == Mode::render) return;
   if (mode == Mode::query) ++stats.state_changes;
@@ -345,7 +387,8 @@ void Renderer::Impl::enter_render_state(BackendStats& stats) {
   glDepthFunc(GL_LESS);
   glDisable(GL_DEPTH_CLAMP);
   glDisable(GL_POLYGON_OFFSET_FILL);
-  if (options.cull_backfaces) glEnable(GL_CULL_FACE);
+  // The query pass culls back faces: set culling both ways.
+  if (options.cull_backfaces) glEnable(GL_CULL_FACE); else glDisable(GL_CULL_FACE);
 }
 
 void Renderer::Impl::enter_query_state(BackendStats& stats) {
@@ -409,7 +452,6 @@ void Renderer::Impl::multi_draw(std::span<const ObjectId> ids) {
     indirect_offset = 0;
   }
   glNamedBufferSubData(indirect_buffer, indirect_offset, bytes, commands.data());
-  glBindBuffer(GL_DRAW_INDIRECT_BUFFER, indirect_buffer);
   glMultiDrawElementsIndirect(GL_TRIANGLES, GL_UNSIGNED_INT,
                               reinterpret_cast<const void*>(indirect_offset), GLsizei(commands.size()),
                               0);
@@ -431,11 +473,7 @@ Renderer::Renderer(const Scene& scene, const RendererOptions& options)
   impl_->create_targets();
   impl_->create_scene_buffers();
   impl_->create_query_resources();
-  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, impl_->object_buffer);
-  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, impl_->material_buffer);
-  glEnable(GL_DEPTH_TEST);
-  glFrontFace(GL_CCW);
-  glCullFace(GL_BACK);
+  // No context state is set here: begin_frame() establishes all of it.
   check_error("creating the renderer");
 }
 
@@ -460,8 +498,7 @@ Renderer::~Renderer() {
 
 void Renderer::begin_frame(const View& view) {
   Impl& g = *impl_;
-  glBindFramebuffer(GL_FRAMEBUFFER, g.fbo);
-  glViewport(0, 0, g.options.width, g.options.height);
+  g.establish_frame_state();
   glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
   glDepthMask(GL_TRUE);
   const glm::vec4 bg(g.options.background, 1.0f);
@@ -602,6 +639,7 @@ bool Renderer::result_available(QueryId q) {
   Impl& g = *impl_;
   ScopedTimer timer(stats_.backend_ms);
   GLuint available = GL_FALSE;
+  glBindBuffer(GL_QUERY_BUFFER, 0);  // results may be read between frames too
   glGetQueryObjectuiv(g.query_names[q], GL_QUERY_RESULT_AVAILABLE, &available);
   return available == GL_TRUE;
 }
@@ -610,6 +648,7 @@ std::uint64_t Renderer::result(QueryId q) {
   Impl& g = *impl_;
   const auto t0 = Clock::now();
   GLuint available = GL_FALSE;
+  glBindBuffer(GL_QUERY_BUFFER, 0);  // results may be read between frames too
   glGetQueryObjectuiv(g.query_names[q], GL_QUERY_RESULT_AVAILABLE, &available);
   if (available != GL_TRUE) ++stats_.blocking_waits;
   GLuint64 samples = 0;
@@ -636,8 +675,7 @@ std::vector<std::uint32_t> Renderer::read_ids() const {
   const Impl& g = *impl_;
   std::vector<std::uint32_t> ids(std::size_t(g.options.width) * std::size_t(g.options.height));
   glNamedFramebufferReadBuffer(g.fbo, GL_COLOR_ATTACHMENT1);
-  glBindFramebuffer(GL_READ_FRAMEBUFFER, g.fbo);
-  glPixelStorei(GL_PACK_ALIGNMENT, 4);
+  bind_for_reading(g.fbo, 4);
   glReadPixels(0, 0, g.options.width, g.options.height, GL_RED_INTEGER, GL_UNSIGNED_INT, ids.data());
   check_error("reading the id buffer");
   return ids;
@@ -648,8 +686,7 @@ std::vector<std::uint8_t> Renderer::read_rgba() const {
   const std::size_t row = std::size_t(g.options.width) * 4;
   std::vector<std::uint8_t> pixels(row * std::size_t(g.options.height));
   glNamedFramebufferReadBuffer(g.fbo, GL_COLOR_ATTACHMENT0);
-  glBindFramebuffer(GL_READ_FRAMEBUFFER, g.fbo);
-  glPixelStorei(GL_PACK_ALIGNMENT, 1);
+  bind_for_reading(g.fbo, 1);
   glReadPixels(0, 0, g.options.width, g.options.height, GL_RGBA, GL_UNSIGNED_BYTE, pixels.data());
   check_error("reading the colour buffer");
   // GL's first row is the bottom one; images start at the top.

@@ -24,7 +24,10 @@ struct RendererOptions {
   int height = 720;
   QueryMode query_mode = QueryMode::samples_passed;
   bool write_ids = true;       ///< also write object ids (id + 1) into the R32UI target
-  bool cull_backfaces = true;  ///< for scene geometry (query boxes are never back-face culled)
+  /// Cull back faces of scene geometry. Query boxes are drawn with their
+  /// back faces culled whatever this says (two-sided only for a query with a
+  /// box around the eye, see Renderer).
+  bool cull_backfaces = true;
   /// Submit each material run of a render() call as one glMultiDrawElementsIndirect
   /// instead of one draw per object (same pixels; less driver overhead per object).
   bool multi_draw = false;
@@ -51,6 +54,17 @@ struct RendererOptions {
 /// around the eye (grown by the near-plane radius), which is drawn two-sided
 /// because the eye sees only its back faces. So a query never reports fewer
 /// samples than its boxes' visible surface has.
+///
+/// GL state: the renderer owns no context state between frames. Every
+/// begin_frame() establishes all the state its passes rely on (framebuffer,
+/// viewport, storage-buffer bindings, depth/cull/blend/scissor state, ...),
+/// each switch between rendering and querying sets that pass's program,
+/// vertex array and masks, and result()/read_ids()/read_rgba() bind what
+/// they read through. So other GL code may use the same context between
+/// frames — another Renderer (NOHC's calibration makes one), or an
+/// engine's own passes — and even delete its objects without effect here.
+/// Between begin_frame() and end_frame() no other GL code may run in the
+/// context.
 ///
 /// Preconditions: a gl::Context is current on the calling thread for the
 /// renderer's whole life; `scene` outlives the renderer and keeps its
@@ -90,6 +104,7 @@ class Renderer final : public Backend {
   struct ObjectPixels {
     ObjectId id;
     std::uint32_t pixels;  ///< opaque: id-buffer pixels; translucent: samples passing the depth test
+    friend bool operator==(const ObjectPixels&, const ObjectPixels&) = default;
   };
   /// Untimed measuring pass (ground truth): draws `objects` for `view` into
   /// the depth and id targets and returns, sorted by id, every object with
