@@ -2,9 +2,12 @@
 #include <gtest/gtest.h>
 
 #include <array>
+#include <filesystem>
 #include <cstdio>
 #include <fstream>
+#include <sstream>
 #include <string>
+#include <vector>
 #include <sys/wait.h>
 
 namespace {
@@ -28,6 +31,22 @@ CliRun run(const std::string& args, const std::string& env = "") {
 }
 
 constexpr const char* kTinyCity = "--scene city:blocks=3,traffic=3 --size 64x48";
+
+// The cells of the table row of `algorithm` (split at spaces); empty if none.
+std::vector<std::string> table_row(const std::string& output, const std::string& algorithm) {
+  std::istringstream lines(output);
+  for (std::string line; std::getline(lines, line);) {
+    std::istringstream cells(line);
+    std::vector<std::string> row;
+    for (std::string c; cells >> c;) row.push_back(c);
+    if (!row.empty() && row[0] == algorithm) return row;
+  }
+  return {};
+}
+
+// Columns of the bench table (after the name).
+enum Column { kMean = 1, kMedian, kP95, kMax, kVsVfc, kVsOracle, kQueries, kStates, kDraws, kTriangles,
+              kMissed, kWrongPixels };
 
 }  // namespace
 
@@ -226,4 +245,28 @@ TEST(Cli, ModelFilesLoadThroughAssimp) {
   const CliRun r = run("bench --scene file:" + obj + " --algo vfc,chcpp,oracle --frames 4 --warmup 0 --size 96x54 --no-report");
   EXPECT_EQ(r.code, 0) << r.output;
   EXPECT_NE(r.output.find("12 triangles"), std::string::npos) << r.output;
+}
+
+// The newcomer's first run: no hardware profile cached, so nohc calibrates
+// in the bench's own process — which once left the ground truth empty and
+// the oracle drawing nothing, with every culler "missing 0".
+TEST(Cli, FirstRunWithAnEmptyCacheCalibratesAndTheOracleDraws) {
+  const std::string cache = ::testing::TempDir() + "occull_empty_cache";
+  std::filesystem::remove_all(cache);
+  const CliRun r = run(std::string("bench ") + kTinyCity + " --algo vfc,nohc,oracle --frames 3 --warmup 1 --no-report",
+                       "XDG_CACHE_HOME=" + cache);
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("calibrating"), std::string::npos) << r.output;
+  const auto oracle = table_row(r.output, "oracle");
+  ASSERT_GT(oracle.size(), std::size_t(kTriangles)) << r.output;
+  EXPECT_GT(std::stod(oracle[kDraws]), 0.0) << r.output;
+  EXPECT_GT(std::stod(oracle[kTriangles]), 0.0) << r.output;
+  EXPECT_EQ(oracle[kMissed], "0");
+  const auto vfc = table_row(r.output, "vfc");
+  ASSERT_GT(vfc.size(), std::size_t(kDraws));
+  EXPECT_GE(std::stod(vfc[kDraws]), std::stod(oracle[kDraws])) << "the oracle draws a subset of vfc";
+  std::size_t profiles = 0;
+  for (const auto& e : std::filesystem::directory_iterator(cache + "/occull"))
+    profiles += e.path().extension() == ".json" ? 1 : 0;
+  EXPECT_EQ(profiles, 1u) << "the calibrated profile is cached";
 }

@@ -94,6 +94,43 @@ TEST(CostModel, QueryTimeAndFragmentClassInterpolation) {
   EXPECT_NEAR(hw.fragment_cost(20), 21e-6, 1e-15);  // beyond: extrapolated
 }
 
+// Where the model says more work costs more, it never costs less.
+TEST(CostModel, TimesNeverFallAsTheWorkGrows) {
+  const HardwareProfile hw = test_profile();
+  NodeCost base;
+  base.draws = 1;
+  base.triangles = 10;
+  base.c_bb = 0.01;
+  for (int step = 0; step < 40; ++step) {
+    NodeCost more = base;
+    more.draws += std::uint32_t(step % 4);
+    more.triangles += std::uint64_t(step) * 97;
+    more.c_bb = std::min(1.0, base.c_bb * (1.0 + 0.3 * step));
+    more.shading_cost = 0.5 * step;
+    EXPECT_GE(render_time(hw, more, 100, 100), render_time(hw, base, 100, 100)) << step;
+    EXPECT_GE(query_time(hw, more.c_bb, 100, 100), query_time(hw, base.c_bb, 100, 100)) << step;
+    EXPECT_GE(hw.fragment_cost(step + 1), hw.fragment_cost(step)) << step;
+  }
+  // Coverage only grows front to back, and the probabilities stay in [0, 1].
+  double c = 0.0;
+  for (int i = 0; i < 50; ++i) {
+    const double next = accumulate_coverage(c, 0.07);
+    EXPECT_GE(next, c);
+    EXPECT_LE(next, 1.0);
+    c = next;
+    for (double c_bb : {0.0, 0.01, 0.3, 1.0}) {
+      const double p_cov = coverage_probability(c, c_bb);
+      EXPECT_GE(p_cov, 0.0);
+      EXPECT_LE(p_cov, 1.0);
+      for (auto prev : {PreviousState::visible, PreviousState::outside, PreviousState::occluded}) {
+        const double p = occlusion_probability(prev, p_cov);
+        EXPECT_GE(p, 0.0);
+        EXPECT_LE(p, 1.0);
+      }
+    }
+  }
+}
+
 TEST(CostModel, MaxParallelQueries) {
   HardwareProfile hw = test_profile();
   // N_q = ceil(0.2 / min(0.02, 0.005 + 0.01)) + 1 = ceil(13.3) + 1 = 15
@@ -200,4 +237,20 @@ TEST(Profile, CachePathNamesTheRenderer) {
   EXPECT_NE(path.find("occull"), std::string::npos);
   EXPECT_NE(path.find("llvmpipe"), std::string::npos);
   EXPECT_EQ(path.find(' '), std::string::npos);
+}
+
+TEST(Profile, SaveReplacesTheFileAndLeavesNoTemporaryBehind) {
+  namespace fs = std::filesystem;
+  const fs::path dir = fs::path(::testing::TempDir()) / "occull_profile_save";
+  fs::remove_all(dir);
+  const std::string path = (dir / "sub" / "p.json").string();
+  HardwareProfile p = test_profile();
+  save_profile(p, path);
+  p.triangle_ms = 3e-5;
+  save_profile(p, path);
+  EXPECT_DOUBLE_EQ(load_profile(path)->triangle_ms, 3e-5);
+  std::size_t files = 0;
+  for ([[maybe_unused]] const auto& e : fs::directory_iterator(dir / "sub")) ++files;
+  EXPECT_EQ(files, 1u);
+  EXPECT_THROW(save_profile(p, "/proc/occull/p.json"), InputError);
 }

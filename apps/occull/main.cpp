@@ -140,6 +140,10 @@ class Progress {
  public:
   Progress() : tty_(isatty(fileno(stderr)) != 0) {}
   void operator()(std::string_view algo, int frame, int frames, bool warmup) {
+    if (frames == 0) {  // a message
+      std::fprintf(stderr, "%.*s\n", int(algo.size()), algo.data());
+      return;
+    }
     const bool last = frame + 1 == frames;
     if (!tty_ && !last) return;
     std::fprintf(stderr, "%s[%.*s] %s %d/%d%s", tty_ ? "\r" : "", int(algo.size()), algo.data(),
@@ -251,7 +255,18 @@ struct CalibrateArgs {
   std::string size = "1280x720";
   int repeats = 5;
   std::string out;
+  bool check = false;
 };
+
+std::string time_text(double ms) {
+  return ms >= 0.01 ? fmt::format("{:.4f} ms", ms) : fmt::format("{:.3f} ns", ms * 1e6);
+}
+
+void print_calibration(const occull::gl::CalibrationResult& result) {
+  fmt::print("{:<10} {:>14} {:>8}  {}\n", "quantity", "time", "spread", "meaning");
+  for (const auto& v : result.values)
+    fmt::print("{:<10} {:>14} {:>7.0f}%  {}\n", v.name, time_text(v.value_ms), 100.0 * v.spread, v.meaning);
+}
 
 int cmd_calibrate(const CalibrateArgs& a) {
   const Size size = parse_size(a.size);
@@ -264,21 +279,37 @@ int cmd_calibrate(const CalibrateArgs& a) {
   o.width = size.width;
   o.height = size.height;
   o.repeats = a.repeats;
-  const auto result = occull::gl::calibrate(o, [](const std::string& line) {
-    std::fprintf(stderr, "%s\n", line.c_str());
-  });
+  const auto progress = [](const std::string& line) { std::fprintf(stderr, "%s\n", line.c_str()); };
+  if (a.check) {
+    // Two independent calibrations, compared: a report, nothing is written.
+    const auto first = occull::gl::calibrate(o, progress);
+    const auto second = occull::gl::calibrate(o, progress);
+    fmt::print("calibration check of {} at {}x{} ({} rounds per run, 2 runs)\n\nfirst run:\n", key,
+               size.width, size.height, a.repeats);
+    print_calibration(first);
+    fmt::print("\nsecond run:\n");
+    print_calibration(second);
+    const auto checks = occull::gl::check_calibrations(first, second);
+    std::size_t failed = 0;
+    fmt::print("\n{:<7} {:<62} {}\n", "verdict", "check", "first | second run");
+    for (const auto& c : checks) {
+      failed += c.ok ? 0 : 1;
+      fmt::print("{:<7} {:<62} {}\n", c.ok ? "ok" : "SUSPECT", c.name, c.detail);
+    }
+    fmt::print("\n{} of {} checks suspect. Timings on a shared machine are noisy: a suspect "
+               "repeatability line says the profile is only as good as its spread; a suspect "
+               "ordering line says the measurement method does not fit this renderer.\n",
+               failed, checks.size());
+    return 0;
+  }
+  const auto result = occull::gl::calibrate(o, progress);
   occull::HardwareProfile profile = result.profile;
   profile.renderer = key;
   const std::string path = a.out.empty() ? occull::default_profile_path(key) : a.out;
   occull::save_profile(profile, path);
   fmt::print("hardware profile of {} at {}x{} ({} rounds, {:.1f} s)\n\n", key, size.width, size.height,
              a.repeats, result.seconds);
-  fmt::print("{:<10} {:>14} {:>8}  {}\n", "quantity", "time", "spread", "meaning");
-  for (const auto& v : result.values) {
-    const std::string time = v.value_ms >= 0.01 ? fmt::format("{:.4f} ms", v.value_ms)
-                                                 : fmt::format("{:.3f} ns", v.value_ms * 1e6);
-    fmt::print("{:<10} {:>14} {:>7.0f}%  {}\n", v.name, time, 100.0 * v.spread, v.meaning);
-  }
+  print_calibration(result);
   fmt::print("\nN_q (queries in flight before the oldest must be done): {}\n", profile.max_parallel_queries());
   fmt::print("spread = (max - min) / median over the rounds; T_o^l is the maximum.\nwritten: {}\n", path);
   return 0;
@@ -378,6 +409,8 @@ int main(int argc, char** argv) {
   cal->add_option("--size", calibrate.size, "render size WIDTHxHEIGHT")->capture_default_str();
   cal->add_option("--repeats", calibrate.repeats, "rounds per measurement (median kept)")->capture_default_str();
   cal->add_option("--out", calibrate.out, "write the profile here instead of the per-user cache");
+  cal->add_flag("--check", calibrate.check,
+                "calibrate twice and report sanity checks (cost ordering, repeatability); writes nothing");
 
   RenderArgs render;
   auto* r = app.add_subcommand("render", "render one frame of a path with an algorithm to a PNG");

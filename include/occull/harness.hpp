@@ -40,7 +40,8 @@ using FrameTruth = std::vector<gl::Renderer::ObjectPixels>;
 
 /// Called as work progresses: a label (algorithm name, or "ground truth"),
 /// the step just done (0-based), the number of steps, and whether it was a
-/// warm-up step.
+/// warm-up step. With 0 steps the label is a message line of its own (e.g.
+/// "calibrating the hardware cost model").
 using ProgressFn = std::function<void(std::string_view label, int step, int steps, bool warmup)>;
 
 /// Verification of one frame: fills truth_objects, missed_objects,

@@ -24,7 +24,10 @@ namespace occull {
 /// when it exists but is unreadable or corrupt.
 [[nodiscard]] std::optional<HardwareProfile> load_profile(const std::string& path);
 
-/// Writes a profile file, creating its folder. Throws InputError on failure.
+/// Writes a profile file, creating its folder. Atomic: the text goes to a
+/// temporary file beside `path` that is then renamed over it, so a
+/// concurrent reader sees the old file or the new one, never a part.
+/// Throws InputError on failure (and leaves no temporary file).
 void save_profile(const HardwareProfile& profile, const std::string& path);
 
 }  // namespace occull

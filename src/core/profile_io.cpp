@@ -10,7 +10,10 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <random>
 #include <sstream>
+
+#include <unistd.h>
 
 namespace occull {
 namespace {
@@ -122,13 +125,30 @@ std::optional<HardwareProfile> load_profile(const std::string& path) {
 void save_profile(const HardwareProfile& profile, const std::string& path) {
   namespace fs = std::filesystem;
   std::error_code ec;
-  const fs::path dir = fs::path(path).parent_path();
+  const fs::path target(path);
+  const fs::path dir = target.parent_path();
   if (!dir.empty()) fs::create_directories(dir, ec);
   if (ec) throw InputError(fmt::format("cannot create '{}': {}", dir.string(), ec.message()));
-  std::ofstream f(path, std::ios::binary);
-  f << profile_to_json(profile);
-  f.flush();
-  if (!f) throw InputError(fmt::format("cannot write '{}'", path));
+  // Written beside the target, then renamed over it: a reader (another
+  // process calibrating the same renderer) sees the old file or the new
+  // one, never half of one.
+  fs::path temp = target;
+  temp += fmt::format(".tmp-{}-{:x}", ::getpid(), std::random_device{}());
+  {
+    std::ofstream f(temp, std::ios::binary);
+    f << profile_to_json(profile);
+    f.flush();
+    if (!f) {
+      fs::remove(temp, ec);
+      throw InputError(fmt::format("cannot write '{}'", temp.string()));
+    }
+  }
+  fs::rename(temp, target, ec);
+  if (ec) {
+    std::error_code ignored;
+    fs::remove(temp, ignored);
+    throw InputError(fmt::format("cannot write '{}': {}", path, ec.message()));
+  }
 }
 
 }  // namespace occull

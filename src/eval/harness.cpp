@@ -371,10 +371,24 @@ BenchResult run_bench(const BenchConfig& config, const ProgressFn& progress) {
   ropts.multi_draw = config.multi_draw;
   Session session(config.scene, ropts, config.bvh);
   const CameraPath& path = session.path(config.path);
+  bool uses_profile = config.model;
+  std::string profile_path;
+  for (const auto& n : names) {
+    const AlgorithmSpec spec = parse_algorithm_spec(n, config.options);
+    if (spec.name != "nohc") continue;
+    if (spec.options.has("nohc.profile"))
+      profile_path = spec.options.values().at("nohc.profile");
+    else
+      uses_profile = true;
+  }
+  // First use on this renderer calibrates (seconds): say so.
+  if (uses_profile) {
+    (void)session.hardware_profile([&](const std::string& line) {
+      if (progress) progress(line, 0, 0, false);
+    });
+    profile_path = session.hardware_profile_path();
+  }
   for (const auto& n : names) (void)session.make(n, config.options);  // options of each, early
-  if (config.model) (void)session.hardware_profile([&](const std::string& line) {
-    if (progress) progress(line, 0, 1, true);
-  });
 
   BenchResult result;
   result.device = session.device();
@@ -391,9 +405,7 @@ BenchResult run_bench(const BenchConfig& config, const ProgressFn& progress) {
   result.repeat = config.repeat;
   result.verified = config.verify;
   result.modelled = config.model;
-  bool uses_profile = config.model;
-  for (const auto& n : names) uses_profile = uses_profile || parse_algorithm_spec(n).name == "nohc";
-  if (uses_profile) result.profile_path = session.hardware_profile_path();
+  result.profile_path = profile_path;
   result.width = config.width;
   result.height = config.height;
 

@@ -195,4 +195,54 @@ CalibrationResult calibrate(const CalibrationOptions& options,
   return result;
 }
 
+std::vector<CalibrationCheck> check_calibrations(const CalibrationResult& first,
+                                                 const CalibrationResult& second) {
+  std::vector<CalibrationCheck> checks;
+  const auto both = [&](const std::string& name, auto&& holds, auto&& figures) {
+    const bool ok = holds(first.profile) && holds(second.profile);
+    checks.push_back({name, ok, fmt::format("{} | {}", figures(first.profile), figures(second.profile))});
+  };
+  const auto ms = [](double v) {
+    return v >= 0.01 ? fmt::format("{:.4f} ms", v) : fmt::format("{:.3f} ns", v * 1e6);
+  };
+  both("every time is finite and >= 0",
+       [&](const HardwareProfile&) {
+         for (const CalibrationResult* r : {&first, &second})
+           for (const CalibratedValue& v : r->values)
+             if (!std::isfinite(v.value_ms) || v.value_ms < 0.0) return false;
+         return true;
+       },
+       [&](const HardwareProfile& p) { return fmt::format("{} fragment classes", p.fragment_ms.size()); });
+  both("a triangle costs less than a draw call (T_r^tri < T_r^s)",
+       [](const HardwareProfile& p) { return p.triangle_ms < p.draw_setup_ms; },
+       [&](const HardwareProfile& p) { return fmt::format("{} < {}", ms(p.triangle_ms), ms(p.draw_setup_ms)); });
+  both("fragments cost more with more shading (T_r^f by shading cost)",
+       [](const HardwareProfile& p) {
+         if (p.fragment_ms.size() < 2) return false;
+         double last = -1.0;
+         for (const auto& [cost, t] : p.fragment_ms) {
+           if (t < last) return false;
+           last = t;
+         }
+         return p.fragment_ms.rbegin()->second > p.fragment_ms.begin()->second;
+       },
+       [&](const HardwareProfile& p) {
+         std::string s;
+         for (const auto& [cost, t] : p.fragment_ms) s += fmt::format("{}[{}] {}", s.empty() ? "" : ", ", cost, ms(t));
+         return s;
+       });
+  both("a query result takes time to arrive (T_o^l > 0)",
+       [](const HardwareProfile& p) { return p.query_latency_ms > 0.0; },
+       [&](const HardwareProfile& p) { return ms(p.query_latency_ms); });
+  for (std::size_t i = 0; i < first.values.size() && i < second.values.size(); ++i) {
+    const CalibratedValue& a = first.values[i];
+    const CalibratedValue& b = second.values[i];
+    const double lo = std::min(a.value_ms, b.value_ms), hi = std::max(a.value_ms, b.value_ms);
+    const bool ok = a.name == b.name && hi <= 2.0 * lo && (lo > 0.0 || hi == 0.0);
+    checks.push_back({fmt::format("{} repeats within a factor of 2", a.name), ok,
+                      fmt::format("{} vs {}", ms(a.value_ms), ms(b.value_ms))});
+  }
+  return checks;
+}
+
 }  // namespace occull::gl

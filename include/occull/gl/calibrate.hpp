@@ -44,4 +44,20 @@ struct CalibrationResult {
 CalibrationResult calibrate(const CalibrationOptions& options = {},
                             const std::function<void(const std::string&)>& progress = {});
 
+/// One sanity check of calibrations (occull calibrate --check).
+struct CalibrationCheck {
+  std::string name;    ///< what is checked
+  bool ok = false;
+  std::string detail;  ///< the figures behind the verdict
+};
+
+/// Sanity checks of two calibrations of the same renderer, in order: every
+/// time finite and >= 0; a triangle cheaper than a draw call; fragment
+/// times not decreasing with shading cost (and the costliest class above
+/// the cheapest); a measured query latency; then, per quantity, the two
+/// runs within a factor of 2 of each other. Timings on a shared machine
+/// are noisy: this is a report for people, never a test. Pure function.
+[[nodiscard]] std::vector<CalibrationCheck> check_calibrations(const CalibrationResult& first,
+                                                               const CalibrationResult& second);
+
 }  // namespace occull::gl
