@@ -57,7 +57,7 @@ class DroppingCuller final : public Culler {
 std::optional<ObjectId> always_visible(const std::vector<FrameTruth>& truth) {
   std::map<ObjectId, std::size_t> frames;
   for (const FrameTruth& t : truth)
-    for (const auto& o : t) ++frames[o.id];
+    for (const auto& o : t.visible) ++frames[o.id];
   for (const auto& [id, n] : frames)
     if (n == truth.size()) return id;
   return std::nullopt;
@@ -166,8 +166,9 @@ TEST(GroundTruth, TranslucentObjectsAreVisibleWithoutHidingWhatIsBehind) {
 TEST_F(HarnessTest, TruthIsNonEmptyAndSortedForEveryFrame) {
   ASSERT_EQ(truth_.size(), std::size_t(kFrames));
   for (const FrameTruth& t : truth_) {
-    EXPECT_FALSE(t.empty());
-    EXPECT_TRUE(std::is_sorted(t.begin(), t.end(), [](auto& a, auto& b) { return a.id < b.id; }));
+    EXPECT_FALSE(t.visible.empty());
+    EXPECT_GT(t.coverage.pixels, 0u);
+    EXPECT_TRUE(std::is_sorted(t.visible.begin(), t.visible.end(), [](auto& a, auto& b) { return a.id < b.id; }));
   }
 }
 
@@ -190,7 +191,7 @@ TEST_F(HarnessTest, OracleRendersExactlyTheTruth) {
   for (std::size_t k = 0; k < run.frames.size(); ++k) {
     EXPECT_EQ(run.frames[k].missed_objects, 0u);
     EXPECT_EQ(run.frames[k].extra_objects, 0u);
-    EXPECT_EQ(run.frames[k].objects_rendered, truth_[k].size());
+    EXPECT_EQ(run.frames[k].objects_rendered, truth_[k].visible.size());
     EXPECT_EQ(run.frames[k].queries, 0u);
   }
 }

@@ -446,6 +446,9 @@ int main(int argc, char** argv) {
   } catch (const occull::GlUnavailable& e) {
     std::cerr << "occull: no usable OpenGL: " << e.what() << "\n";
     return kExitNoGl;
+  } catch (const occull::InvariantViolation& e) {
+    std::cerr << "occull: " << e.what() << "\n";
+    return kExitInternal;
   } catch (const std::exception& e) {
     std::cerr << "occull: internal error: " << e.what() << "\n";
     return kExitInternal;

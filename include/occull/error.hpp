@@ -22,4 +22,13 @@ class GlUnavailable : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+/// A run-time invariant of the measuring instrument failed (e.g. the ground
+/// truth is empty while the frame shows objects): nothing it measured can be
+/// trusted, so the run stops. The message names the invariant, the scene,
+/// the path and the frame. Tools map it to exit code 1.
+class InvariantViolation : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
 }  // namespace occull

@@ -35,8 +35,21 @@
 
 namespace occull {
 
-/// Ground truth of one frame: visible objects sorted by id, with their pixels.
-using FrameTruth = std::vector<gl::Renderer::ObjectPixels>;
+/// Where opaque geometry covers an image: one bit per pixel (row-major,
+/// bottom row first, bit i of word i / 64), how many pixels, and a hash of
+/// the depth image (equal hashes: bit-identical depth).
+struct Coverage {
+  std::vector<std::uint64_t> bits;
+  std::uint64_t pixels = 0;
+  std::uint64_t depth_hash = 0;
+};
+
+/// Ground truth of one frame.
+struct FrameTruth {
+  std::vector<gl::Renderer::ObjectPixels> visible;  ///< objects with a visible pixel, sorted by id
+  Coverage coverage;                                ///< of the truth pass's depth image
+  std::uint32_t probes = 0;  ///< triangles the CPU probe (truth-probe) checked in this frame
+};
 
 /// Called as work progresses: a label (algorithm name, or "ground truth"),
 /// the step just done (0-based), the number of steps, and whether it was a
@@ -60,8 +73,30 @@ struct AlgorithmRun {
   std::uint32_t longest_miss_frames = 0;  ///< longest run of frames one object stayed missed
 };
 
+/// Fault injection, for tests only: each hook, when set, may corrupt one
+/// step of the instrument, so a test can see the run-time invariant that
+/// guards that step stop the run (a check never seen failing is not trusted).
+struct FaultHooks {
+  /// The objects the truth pass is about to draw (those inside the frustum).
+  std::function<void(std::vector<ObjectId>& drawn)> truth_objects;
+  /// What the truth pass found and the images it read back.
+  std::function<void(std::vector<gl::Renderer::ObjectPixels>& visible, gl::Renderer::PassImages& images)>
+      truth_images;
+  /// The objects the oracle is told to render.
+  std::function<void(std::vector<ObjectId>& visible)> oracle_objects;
+  /// The depth image of a verified frame of an algorithm, as read back.
+  std::function<void(std::vector<float>& depth)> frame_depth;
+};
+
 /// A scene set up on the GL device: the context, the generated scene with
 /// its paths, its BVH and the renderer. Everything a run of frames needs.
+///
+/// Verified runs check the run-time invariants of src/eval/invariants.hpp
+/// on every frame (the truth pass covers what the full scene shows, the
+/// truth is non-empty where anything is drawn, an independent CPU probe of
+/// sampled triangles, every algorithm frame within the truth, the oracle
+/// reproducing it exactly) and throw InvariantViolation on the first that
+/// fails.
 class Session {
  public:
   /// Builds the scene from `scene_spec` (throws InputError) and its BVH,
@@ -84,9 +119,13 @@ class Session {
   /// glFinish). Fills every timing and backend counter of the result.
   FrameStats run_frame(Culler& culler, const View& view, double time_s);
 
-  /// The ground truth of frames 0..frames-1 of `path` (untimed).
+  /// The ground truth of frames 0..frames-1 of `path` (untimed), each
+  /// frame checked by the truth invariants. Throws InvariantViolation.
   [[nodiscard]] std::vector<FrameTruth> ground_truth(const CameraPath& path, int frames,
                                                      const ProgressFn& progress = {});
+
+  /// Test hooks (see FaultHooks); empty by default.
+  void set_fault_hooks(FaultHooks hooks) { hooks_ = std::move(hooks); }
 
   /// Makes a culler from an algorithm spec ("chcpp" or
   /// "chcpp:multiquery=off", see parse_algorithm_spec) for this scene;
@@ -102,6 +141,8 @@ class Session {
                             const std::vector<FrameTruth>* truth);
 
   /// With `predict`, also fills FrameStats::model_ms (see predicted_frame_ms).
+  /// With `truth`, checks every frame against it (frame-within-truth, and
+  /// oracle-draws-truth for the oracle); throws InvariantViolation.
   AlgorithmRun run_path(std::string_view name, Culler& culler, const CameraPath& path, int frames,
                         const std::vector<FrameTruth>* truth, const ProgressFn& progress = {},
                         bool predict = false);
@@ -139,6 +180,7 @@ class Session {
   // Declared (so initialised) before bundle_, which records into it.
   double scene_build_ms_ = 0.0;
   double bvh_build_ms_ = 0.0;
+  std::string scene_spec_;
   SceneBundle bundle_;
   Bvh bvh_;
   std::unique_ptr<gl::Context> context_;
@@ -146,6 +188,7 @@ class Session {
   gl::RendererOptions renderer_options_;
   std::unique_ptr<gl::Renderer> renderer_;
   std::optional<HardwareProfile> profile_;
+  FaultHooks hooks_;
 };
 
 struct BenchConfig {
@@ -163,6 +206,7 @@ struct BenchConfig {
   bool multi_draw = false;                ///< see gl::RendererOptions::multi_draw
   BvhOptions bvh;                         ///< how the scene's hierarchy is built
   bool model = false;                     ///< also predict each frame with the NOHC cost model
+  FaultHooks hooks;                       ///< tests only: break a step on purpose (see FaultHooks)
 };
 
 /// Mean, median, 95th percentile and maximum of a sample (all 0 when empty).
@@ -217,6 +261,8 @@ struct BenchResult {
   int warmup = 0;
   int repeat = 1;
   bool verified = false;
+  std::uint64_t truth_probes = 0;    ///< triangles the truth-probe invariant checked, all frames
+  std::uint64_t truth_pixels = 0;    ///< pixels the truth covers, summed over frames
   bool modelled = false;          ///< frames carry cost-model predictions
   std::string profile_path;       ///< the hardware profile used (when modelled or nohc ran)
   int width = 0;

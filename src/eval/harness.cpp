@@ -2,6 +2,7 @@
 
 #include "occull/error.hpp"
 #include "occull/gl/calibrate.hpp"
+#include "invariants.hpp"
 #include "occull/profile_io.hpp"
 #include "oracle.hpp"
 
@@ -62,7 +63,7 @@ std::vector<ObjectId> check_frame(std::span<const gl::Renderer::ObjectPixels> tr
 // The scene first: a bad spec is reported before any GL work.
 Session::Session(std::string_view scene_spec, const gl::RendererOptions& renderer_options,
                  const BvhOptions& bvh_options)
-    : bundle_(timed_make_scene(scene_spec, scene_build_ms_)) {
+    : scene_spec_(scene_spec), bundle_(timed_make_scene(scene_spec, scene_build_ms_)) {
   const auto t0 = Clock::now();
   bvh_ = Bvh::build(bundle_.scene, bvh_options);
   bvh_build_ms_ = ms_between(t0, Clock::now());
@@ -133,15 +134,40 @@ std::vector<FrameTruth> Session::ground_truth(const CameraPath& path, int frames
                                               const ProgressFn& progress) {
   std::vector<FrameTruth> truth;
   truth.reserve(std::size_t(frames));
-  std::vector<ObjectId> in_frustum;
+  const Scene& scene = bundle_.scene;
+  const auto objects = scene.objects();
+  std::vector<ObjectId> in_frustum, outside;
+  std::vector<std::uint8_t> drawn(objects.size());
   for (int k = 0; k < frames; ++k) {
     bundle_.scene.update(path.frame_time(k, frames));
     const View view = view_at(path, k, frames);
+    const detail::FrameLabel where{scene_spec_, path.name(), k};
     in_frustum.clear();
-    const auto objects = bundle_.scene.objects();
     for (ObjectId id = 0; id < objects.size(); ++id)
       if (view.frustum.classify(objects[id].bounds) != Containment::outside) in_frustum.push_back(id);
-    truth.push_back(renderer_->visible_pixels(view, in_frustum));
+    if (hooks_.truth_objects) hooks_.truth_objects(in_frustum);
+
+    FrameTruth t;
+    gl::Renderer::PassImages images;
+    t.visible = renderer_->visible_pixels(view, in_frustum, &images);
+    if (hooks_.truth_images) hooks_.truth_images(t.visible, images);
+    // The full scene, for comparison: every opaque object left out of the
+    // truth pass, drawn over its depth, must not pass a single sample.
+    std::fill(drawn.begin(), drawn.end(), 0);
+    for (ObjectId id : in_frustum) drawn[id] = 1;
+    outside.clear();
+    for (ObjectId id = 0; id < objects.size(); ++id)
+      if (!drawn[id] && !scene.material(objects[id].material).translucent) outside.push_back(id);
+    const std::uint64_t outside_samples = renderer_->samples_in_front(view, outside);
+
+    std::sort(in_frustum.begin(), in_frustum.end());
+    detail::check_truth_in_frustum(where, t.visible, in_frustum);
+    detail::check_truth_covers_full_render(where, images.ids, images.depth, outside_samples);
+    detail::check_truth_not_empty(where, t.visible, images.ids, scene);
+    t.probes = std::uint32_t(detail::check_truth_probes(where, scene, view, in_frustum, images.depth,
+                                                         renderer_options_.cull_backfaces));
+    t.coverage = detail::depth_coverage(images.depth);
+    truth.push_back(std::move(t));
     if (progress) progress("ground truth", k, frames, false);
   }
   return truth;
@@ -210,8 +236,9 @@ FrameStats Session::run_path_frame(Culler& culler, const CameraPath& path, int k
   if (auto* oracle = dynamic_cast<detail::OracleCuller*>(&culler)) {
     if (!truth) throw InputError("the oracle needs ground truth: run it with verification on");
     std::vector<ObjectId> visible;
-    visible.reserve((*truth)[std::size_t(k)].size());
-    for (const auto& t : (*truth)[std::size_t(k)]) visible.push_back(t.id);
+    visible.reserve((*truth)[std::size_t(k)].visible.size());
+    for (const auto& t : (*truth)[std::size_t(k)].visible) visible.push_back(t.id);
+    if (hooks_.oracle_objects) hooks_.oracle_objects(visible);
     oracle->set_visible(std::move(visible));
   }
   return run_frame(culler, view_at(path, k, frames), path.frame_time(k, frames));
@@ -229,9 +256,17 @@ AlgorithmRun Session::run_path(std::string_view name, Culler& culler, const Came
     if (predict) s.model_ms = predicted_frame_ms(view_at(path, k, frames));
     if (truth) {
       // Outside the timed region: compare what was rendered with the truth.
+      const FrameTruth& t = (*truth)[std::size_t(k)];
+      const detail::FrameLabel where{scene_spec_, path.name(), k};
+      std::vector<float> depth = renderer_->read_depth();
+      if (hooks_.frame_depth) hooks_.frame_depth(depth);
+      const Coverage frame = detail::depth_coverage(depth);
+      detail::check_frame_within_truth(where, std::string(name), t.coverage, frame);
+      if (dynamic_cast<const detail::OracleCuller*>(&culler))
+        detail::check_oracle_draws_truth(where, t.visible, renderer_->frame_objects(), t.coverage.depth_hash,
+                                         frame.depth_hash);
       const std::vector<ObjectId> missed =
-          check_frame((*truth)[std::size_t(k)], renderer_->frame_objects(),
-                      bundle_.scene.objects().size(), s);
+          check_frame(t.visible, renderer_->frame_objects(), bundle_.scene.objects().size(), s);
       for (ObjectId id : previously_missed)
         if (!std::binary_search(missed.begin(), missed.end(), id)) miss_run[id] = 0;
       for (ObjectId id : missed) run.longest_miss_frames = std::max(run.longest_miss_frames, ++miss_run[id]);
@@ -370,6 +405,7 @@ BenchResult run_bench(const BenchConfig& config, const ProgressFn& progress) {
   ropts.write_ids = false;  // timed frames draw colour and depth only
   ropts.multi_draw = config.multi_draw;
   Session session(config.scene, ropts, config.bvh);
+  session.set_fault_hooks(config.hooks);
   const CameraPath& path = session.path(config.path);
   bool uses_profile = config.model;
   std::string profile_path;
@@ -412,6 +448,10 @@ BenchResult run_bench(const BenchConfig& config, const ProgressFn& progress) {
   std::vector<FrameTruth> truth;
   if (config.verify) truth = session.ground_truth(path, config.frames, progress);
   const std::vector<FrameTruth>* truth_ptr = config.verify ? &truth : nullptr;
+  for (const FrameTruth& t : truth) {
+    result.truth_probes += t.probes;
+    result.truth_pixels += t.coverage.pixels;
+  }
 
   for (int rep = 0; rep < config.repeat; ++rep) {
     for (const auto& name : names) {

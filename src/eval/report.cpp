@@ -42,12 +42,19 @@ detail::LineChart chart(const BenchResult& r, std::string title, std::string y_l
   return c;
 }
 
+std::string verification_text(const BenchResult& r) {
+  if (!r.verified) return "verification off";
+  return fmt::format("verification on (invariants held on every frame; truth covers {:.0f}% of the "
+                     "pixels, {} triangles probed on the CPU)",
+                     100.0 * double(r.truth_pixels) / std::max(1.0, double(r.width) * r.height * r.frames),
+                     r.truth_probes);
+}
+
 std::string setup_line(const BenchResult& r) {
   return fmt::format("scene {} ({} objects, {} triangles; BVH {} nodes in {:.1f} ms), path {}, {} frames "
-                     "at {}x{}, {} warm-up, {} repeat{}, verification {}",
+                     "at {}x{}, {} warm-up, {} repeat{}, {}",
                      r.scene, r.objects, r.triangles, r.bvh_nodes, r.bvh_build_ms, r.path, r.frames,
-                     r.width, r.height, r.warmup, r.repeat, r.repeat == 1 ? "" : "s",
-                     r.verified ? "on" : "off");
+                     r.width, r.height, r.warmup, r.repeat, r.repeat == 1 ? "" : "s", verification_text(r));
 }
 
 std::string misses_text(const BenchResult& r, std::uint64_t v) {
@@ -107,6 +114,8 @@ void write_json(const BenchResult& r, std::ostream& out) {
   doc["warmup"] = r.warmup;
   doc["repeat"] = r.repeat;
   doc["verified"] = r.verified;
+  doc["truth_probes"] = r.truth_probes;
+  doc["truth_pixels"] = r.truth_pixels;
   doc["modelled"] = r.modelled;
   if (!r.profile_path.empty()) doc["hardware_profile"] = r.profile_path;
   doc["size"] = {r.width, r.height};
@@ -213,7 +222,7 @@ std::vector<std::string> write_report(const BenchResult& r, const std::string& d
   md += fmt::format("- path: `{}`, {} frames at {}×{}, {} warm-up frames per algorithm\n", r.path, r.frames,
                     r.width, r.height, r.warmup);
   md += fmt::format("- repeats: {} (algorithms interleaved; figures are medians over repeats)\n", r.repeat);
-  md += fmt::format("- verification against ground truth: {}\n", r.verified ? "on" : "off");
+  md += fmt::format("- {}\n", verification_text(r));
   md += fmt::format("- occull commit: `{}`\n\n## Results\n\n", r.commit);
   md += "| algorithm | mean ms | median | p95 | max | vs vfc | vs oracle | queries | state changes | "
         "draws | triangles | missed | frames w/ miss | wrong px | longest miss | extra objects | "

@@ -190,6 +190,8 @@ struct Renderer::Impl {
   void create_query_resources();
   void apply_draw_buffers() const;
   void establish_frame_state() const;
+  void prepare_pass(const View& view);
+  std::uint64_t samples_passing(std::span<const ObjectId> ids);
   void enter_render_state(BackendStats& stats);
   void enter_query_state(BackendStats& stats);
   void draw_objects(std::span<const ObjectId> ids, BackendStats& stats);
@@ -496,37 +498,38 @@ Renderer::~Renderer() {
   glDeleteRenderbuffers(3, rbs);
 }
 
+// Context state, camera and per-frame bookkeeping of a pass over `view`;
+// the targets keep what they hold.
+void Renderer::Impl::prepare_pass(const View& view) {
+  establish_frame_state();
+  upload_dynamic_transforms();
+  glProgramUniformMatrix4fv(scene_program, u_scene_view_proj, 1, GL_FALSE, glm::value_ptr(view.view_proj));
+  glProgramUniformMatrix4fv(query_program, u_query_view_proj, 1, GL_FALSE, glm::value_ptr(view.view_proj));
+  glProgramUniform3fv(scene_program, u_eye, 1, glm::value_ptr(view.eye));
+  glProgramUniform3fv(scene_program, u_background, 1, glm::value_ptr(options.background));
+  glProgramUniform1f(scene_program, u_fog, std::max(view.far, 1.0f));
+  eye = view.eye;
+  near_radius = near_plane_radius(view);
+  translucent.clear();
+  frame_objects.clear();
+  frame_query_boxes.clear();
+  frame_query_sizes.clear();
+  bound_material = ~0u;
+  // Start in render state without counting it as a change.
+  mode = Mode::none;
+  BackendStats ignored;
+  enter_render_state(ignored);
+}
+
 void Renderer::begin_frame(const View& view) {
   Impl& g = *impl_;
-  g.establish_frame_state();
-  glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
-  glDepthMask(GL_TRUE);
+  g.prepare_pass(view);
   const glm::vec4 bg(g.options.background, 1.0f);
   glClearNamedFramebufferfv(g.fbo, GL_COLOR, 0, glm::value_ptr(bg));
   const GLuint zero[4] = {0, 0, 0, 0};
   if (g.write_ids) glClearNamedFramebufferuiv(g.fbo, GL_COLOR, 1, zero);
   const float one = 1.0f;
   glClearNamedFramebufferfv(g.fbo, GL_DEPTH, 0, &one);
-
-  g.upload_dynamic_transforms();
-  glProgramUniformMatrix4fv(g.scene_program, g.u_scene_view_proj, 1, GL_FALSE,
-                            glm::value_ptr(view.view_proj));
-  glProgramUniformMatrix4fv(g.query_program, g.u_query_view_proj, 1, GL_FALSE,
-                            glm::value_ptr(view.view_proj));
-  glProgramUniform3fv(g.scene_program, g.u_eye, 1, glm::value_ptr(view.eye));
-  glProgramUniform3fv(g.scene_program, g.u_background, 1, glm::value_ptr(g.options.background));
-  glProgramUniform1f(g.scene_program, g.u_fog, std::max(view.far, 1.0f));
-  g.eye = view.eye;
-  g.near_radius = near_plane_radius(view);
-  g.translucent.clear();
-  g.frame_objects.clear();
-  g.frame_query_boxes.clear();
-  g.frame_query_sizes.clear();
-  g.bound_material = ~0u;
-  // Start every frame in render state without counting it as a change.
-  g.mode = Impl::Mode::none;
-  BackendStats ignored;
-  g.enter_render_state(ignored);
   // Fresh storage for this frame's query boxes (orphaning: the previous
   // frame's draws keep their copy).
   glNamedBufferData(g.box_buffer, kBoxCapacity * GLsizeiptr(sizeof(Aabb)), nullptr, GL_STREAM_DRAW);
@@ -703,8 +706,46 @@ std::span<const std::uint32_t> Renderer::frame_query_sizes() const noexcept {
   return impl_->frame_query_sizes;
 }
 
+// Draws `ids` against the depth buffer as it stands, writing nothing, and
+// returns the samples that pass (GL_LESS, as the scene pass). Not counted.
+std::uint64_t Renderer::Impl::samples_passing(std::span<const ObjectId> ids) {
+  BackendStats ignored;
+  enter_render_state(ignored);
+  glDepthMask(GL_FALSE);
+  glColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
+  glBeginQuery(GL_SAMPLES_PASSED, truth_query);
+  draw_objects(ids, ignored);
+  glEndQuery(GL_SAMPLES_PASSED);
+  glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+  glDepthMask(GL_TRUE);
+  GLuint64 n = 0;
+  glBindBuffer(GL_QUERY_BUFFER, 0);
+  glGetQueryObjectui64v(truth_query, GL_QUERY_RESULT, &n);
+  return n;
+}
+
+std::uint64_t Renderer::samples_in_front(const View& view, std::span<const ObjectId> objects) {
+  Impl& g = *impl_;
+  g.prepare_pass(view);
+  const std::uint64_t n = objects.empty() ? 0 : g.samples_passing(objects);
+  glFinish();
+  g.frame_objects.clear();
+  check_error("counting samples in front of the depth buffer");
+  return n;
+}
+
+std::vector<float> Renderer::read_depth() const {
+  const Impl& g = *impl_;
+  std::vector<float> depth(std::size_t(g.options.width) * std::size_t(g.options.height));
+  bind_for_reading(g.fbo, 4);
+  glReadPixels(0, 0, g.options.width, g.options.height, GL_DEPTH_COMPONENT, GL_FLOAT, depth.data());
+  check_error("reading the depth buffer");
+  return depth;
+}
+
 std::vector<Renderer::ObjectPixels> Renderer::visible_pixels(const View& view,
-                                                             std::span<const ObjectId> objects) {
+                                                             std::span<const ObjectId> objects,
+                                                             PassImages* images) {
   Impl& g = *impl_;
   const BackendStats saved_stats = stats_;
   const bool saved_ids = g.write_ids;
@@ -717,28 +758,18 @@ std::vector<Renderer::ObjectPixels> Renderer::visible_pixels(const View& view,
   g.draw_objects(g.opaque, stats_);
 
   std::vector<std::uint64_t> samples(translucent.size());
-  if (!translucent.empty()) {
-    // Depth test against the opaque scene, no writes at all.
-    glDepthMask(GL_FALSE);
-    glColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
-    glColorMaski(1, GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
-    for (std::size_t i = 0; i < translucent.size(); ++i) {
-      glBeginQuery(GL_SAMPLES_PASSED, g.truth_query);
-      g.draw_objects(std::span<const ObjectId>(&translucent[i], 1), stats_);
-      glEndQuery(GL_SAMPLES_PASSED);
-      GLuint64 n = 0;
-      glGetQueryObjectui64v(g.truth_query, GL_QUERY_RESULT, &n);
-      samples[i] = n;
-    }
-    glColorMaski(1, GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
-    glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
-    glDepthMask(GL_TRUE);
-  }
+  for (std::size_t i = 0; i < translucent.size(); ++i)
+    samples[i] = g.samples_passing(std::span<const ObjectId>(&translucent[i], 1));
   end_frame();
 
+  std::vector<std::uint32_t> ids = read_ids();
   g.pixel_counts.assign(g.scene.objects().size(), 0);
-  for (std::uint32_t v : read_ids())
+  for (std::uint32_t v : ids)
     if (v != 0) ++g.pixel_counts[v - 1];
+  if (images) {
+    images->ids = std::move(ids);
+    images->depth = read_depth();
+  }
   for (std::size_t i = 0; i < translucent.size(); ++i)
     g.pixel_counts[translucent[i]] = std::uint32_t(std::min<std::uint64_t>(samples[i], 0xffffffffu));
   std::vector<ObjectPixels> visible;

@@ -106,15 +106,34 @@ class Renderer final : public Backend {
     std::uint32_t pixels;  ///< opaque: id-buffer pixels; translucent: samples passing the depth test
     friend bool operator==(const ObjectPixels&, const ObjectPixels&) = default;
   };
+  /// The images a measuring pass read back (row-major, bottom row first).
+  struct PassImages {
+    std::vector<std::uint32_t> ids;  ///< 0 background, else object id + 1
+    std::vector<float> depth;        ///< window depth in [0, 1]; 1 where nothing opaque was drawn
+  };
+
   /// Untimed measuring pass (ground truth): draws `objects` for `view` into
   /// the depth and id targets and returns, sorted by id, every object with
   /// at least one visible pixel. Opaque objects count the pixels they own in
   /// the id buffer; translucent ones (which never occlude) are tested with
   /// one occlusion query over their own triangles after all opaque ones.
+  /// With `images`, also hands back the id and depth images it drew.
   /// Overwrites the frame's targets; does not count in stats(). Call it
   /// outside begin_frame()/end_frame().
   [[nodiscard]] std::vector<ObjectPixels> visible_pixels(const View& view,
-                                                         std::span<const ObjectId> objects);
+                                                         std::span<const ObjectId> objects,
+                                                         PassImages* images = nullptr);
+
+  /// Untimed: draws `objects` for `view` against the depth buffer as the
+  /// last pass left it (e.g. visible_pixels()), writing nothing, and returns
+  /// how many samples pass its depth test (GL_LESS, as the scene pass): 0
+  /// when none of them would change that pass's image. Does not count in
+  /// stats(). Call it outside begin_frame()/end_frame().
+  [[nodiscard]] std::uint64_t samples_in_front(const View& view, std::span<const ObjectId> objects);
+
+  /// The depth target after end_frame(): width*height window depths in
+  /// [0, 1], bottom row first; 1 where no opaque object was drawn.
+  [[nodiscard]] std::vector<float> read_depth() const;
 
   /// Writing object ids can be switched off (timed runs that do not verify).
   void set_write_ids(bool on);
