@@ -107,3 +107,15 @@ TEST(Vfc, RendersFrontToBackByNode) {
   ASSERT_EQ(backend.rendered.size(), 32u);
   for (std::size_t i = 0; i < 32; ++i) EXPECT_EQ(backend.rendered[i], ObjectId(i));
 }
+
+TEST(Registry, AThresholdAboveZeroMakesARunApproximate) {
+  EXPECT_TRUE(is_conservative(parse_algorithm_spec("chc")));
+  EXPECT_TRUE(is_conservative(parse_algorithm_spec("chc:threshold=0")));
+  EXPECT_FALSE(is_conservative(parse_algorithm_spec("chc:threshold=3")));
+  EXPECT_TRUE(is_conservative(parse_algorithm_spec("vfc")));
+  EXPECT_FALSE(is_conservative(parse_algorithm_spec("perobject")));
+  Options base;
+  base.set("chcpp.threshold=2");  // --opt chcpp.threshold=2 reaches every chcpp spec
+  EXPECT_FALSE(is_conservative(parse_algorithm_spec("chcpp:batch=10", base)));
+  EXPECT_TRUE(is_conservative(parse_algorithm_spec("nohc", base)));
+}

@@ -96,7 +96,7 @@ TEST(CheckFrame, CountsMissedWrongPixelsAndExtraObjects) {
 
 TEST(SummarizeRuns, MediansOverRepeatsAndRatiosWithinARepeat) {
   const auto run = [](const char* name, int rep, std::vector<double> ms, std::uint32_t missed) {
-    AlgorithmRun r{name, rep, {}, 0};
+    AlgorithmRun r{name, rep, true, {}, 0};
     for (double m : ms) {
       FrameStats f;
       f.frame_ms = m;
@@ -118,6 +118,41 @@ TEST(SummarizeRuns, MediansOverRepeatsAndRatiosWithinARepeat) {
   EXPECT_DOUBLE_EQ(s[1].queries_per_frame, 10.0);
   EXPECT_EQ(s[1].missed_objects, 2u);  // the worst repeat
   EXPECT_EQ(s[1].ratio_to_oracle, 0.0);
+}
+
+TEST(Verdict, MissesOfConservativeRunsFailThoseOfOthersArePopping) {
+  const auto run = [](const char* name, bool conservative, std::uint32_t missed) {
+    AlgorithmRun r{name, 0, conservative, {}, 0};
+    FrameStats f;
+    f.frame_ms = 1.0;
+    f.missed_objects = missed;
+    r.frames.assign(3, f);
+    return r;
+  };
+  BenchResult r;
+  r.verified = true;
+  r.width = r.height = 8;
+  r.frames = 3;
+  r.runs = {run("vfc", true, 0), run("perobject", false, 2), run("chc:threshold=4", false, 1)};
+  r.summaries = summarize_runs(r.runs);
+  EXPECT_TRUE(verification_failures(r).empty());
+  std::ostringstream table;
+  print_table(r, table);
+  EXPECT_NE(table.str().find("verification passed: the conservative algorithms (vfc)"), std::string::npos)
+      << table.str();
+  EXPECT_NE(table.str().find("perobject: 6 missed over 3 frames"), std::string::npos) << table.str();
+
+  r.runs.push_back(run("chc", true, 1));
+  r.summaries = summarize_runs(r.runs);
+  const auto failed = verification_failures(r);
+  ASSERT_EQ(failed.size(), 1u);
+  EXPECT_EQ(failed[0]->name, "chc");
+  std::ostringstream failing;
+  print_table(r, failing);
+  EXPECT_NE(failing.str().find("verification FAILED"), std::string::npos) << failing.str();
+  EXPECT_NE(failing.str().find("chc missed 3 visible objects in 3 frames"), std::string::npos) << failing.str();
+  r.verified = false;  // nothing was checked: nothing failed
+  EXPECT_TRUE(verification_failures(r).empty());
 }
 
 TEST(Summarize, MeanMedianPercentileMax) {

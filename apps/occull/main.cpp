@@ -1,9 +1,11 @@
 // occull — command-line tool: device info, scenes, algorithms, benchmarks
 // and screenshots.
 //
-// Exit codes: 0 success; 1 unexpected internal error; 2 bad input (unknown
-// name, invalid number, bad option, corrupt file); 3 no usable OpenGL 4.5
-// (EGL or driver missing).
+// Exit codes: 0 success; 1 unexpected internal error (also a violated
+// run-time invariant of the instrument); 2 bad input (unknown name, invalid
+// number, bad option, corrupt file); 3 no usable OpenGL 4.5 (EGL or driver
+// missing); 4 bench: a conservative algorithm missed a visible object (the
+// table and report are written first).
 #include "occull/culler.hpp"
 #include "occull/error.hpp"
 #include "occull/gl/calibrate.hpp"
@@ -18,6 +20,7 @@
 #include <fmt/format.h>
 #include <stb_image_write.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <fstream>
@@ -30,6 +33,7 @@ namespace {
 constexpr int kExitInternal = 1;
 constexpr int kExitInput = 2;
 constexpr int kExitNoGl = 3;
+constexpr int kExitVerificationFailed = 4;
 
 struct Size {
   int width = 1280;
@@ -129,7 +133,12 @@ int cmd_scenes() {
 
 int cmd_algos() {
   for (const auto& a : occull::algorithms()) {
-    fmt::print("{:<10} {}{}\n", a.name, a.summary, a.conservative ? "" : " (may pop: not conservative)");
+    const bool has_threshold = std::any_of(a.options.begin(), a.options.end(),
+                                           [](const occull::OptionInfo& o) { return o.key == "threshold"; });
+    fmt::print("{:<10} {}{}\n", a.name, a.summary,
+               !a.conservative ? " (may pop: not conservative)"
+               : has_threshold ? " (conservative; threshold > 0 makes a run approximate)"
+                               : " (conservative)");
     for (const auto& o : a.options)
       fmt::print("    --opt {}.{}={}  {}\n", a.name, o.key, o.default_value, o.help);
   }
@@ -248,7 +257,8 @@ int cmd_bench(const BenchArgs& a) {
     const auto files = occull::write_report(result, a.report);
     std::fprintf(stderr, "report: %s/report.md (%zu files)\n", a.report.c_str(), files.size());
   }
-  return 0;
+  // A conservative culler that misses a visible object is broken, whatever its frame time.
+  return occull::verification_failures(result).empty() ? 0 : kExitVerificationFailed;
 }
 
 struct CalibrateArgs {
@@ -357,8 +367,9 @@ int cmd_render(const RenderArgs& a) {
 
 int main(int argc, char** argv) {
   CLI::App app{"occull — occlusion culling with hardware occlusion queries, and the instrument "
-               "that measures it.\n\nExit codes: 0 success, 1 internal error, 2 bad input, "
-               "3 no usable OpenGL 4.5."};
+               "that measures it.\n\nExit codes: 0 success, 1 internal error (or a violated invariant of the "
+               "instrument), 2 bad input, 3 no usable OpenGL 4.5, 4 a conservative algorithm missed a "
+               "visible object (bench)."};
   app.require_subcommand(1);
 
   app.add_subcommand("info", "GL vendor, renderer, version, query counter bits, culling extensions");

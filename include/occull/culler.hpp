@@ -93,6 +93,13 @@ struct AlgorithmSpec {
 /// an item that is not key=value.
 [[nodiscard]] AlgorithmSpec parse_algorithm_spec(std::string_view spec, const Options& base = {});
 
+/// Whether a run of `spec` must never cull a visible object: its algorithm
+/// is conservative and no option makes it approximate — `threshold` > 0
+/// culls nodes with up to that many visible pixels, so such a run may pop.
+/// The harness reports misses of a conservative run as failures and those
+/// of any other run as popping.
+[[nodiscard]] bool is_conservative(const AlgorithmSpec& spec);
+
 /// Checks every key of `options`: its algorithm must exist and know the
 /// option. Throws InputError listing the valid algorithms or options.
 void check_options(const Options& options);

@@ -69,6 +69,7 @@ std::vector<ObjectId> check_frame(std::span<const gl::Renderer::ObjectPixels> tr
 struct AlgorithmRun {
   std::string name;
   int repeat = 0;
+  bool conservative = true;  ///< must miss nothing (is_conservative of its spec)
   std::vector<FrameStats> frames;
   std::uint32_t longest_miss_frames = 0;  ///< longest run of frames one object stayed missed
 };
@@ -221,6 +222,7 @@ struct Summary {
 /// are the worst repeat's.
 struct AlgorithmSummary {
   std::string name;
+  bool conservative = true;      ///< its misses are failures; otherwise popping
   Summary frame_ms;
   double ratio_to_vfc = 0.0;     ///< mean frame time / vfc's in the same repeat; 0 if vfc did not run
   double ratio_to_oracle = 0.0;  ///< same against the oracle
@@ -270,6 +272,10 @@ struct BenchResult {
   std::vector<AlgorithmRun> runs;            ///< in execution order
   std::vector<AlgorithmSummary> summaries;   ///< one per algorithm, in the order asked
 };
+
+/// The conservative algorithms of a verified result that missed a visible
+/// object (empty when verification passed or did not run).
+[[nodiscard]] std::vector<const AlgorithmSummary*> verification_failures(const BenchResult& result);
 
 /// Summaries of `runs` (see AlgorithmSummary), one per algorithm name in
 /// first-appearance order.

@@ -203,6 +203,12 @@ AlgorithmSpec parse_algorithm_spec(std::string_view spec, const Options& base) {
   return out;
 }
 
+bool is_conservative(const AlgorithmSpec& spec) {
+  if (!find_algorithm(spec.name).conservative) return false;
+  const std::string threshold = spec.name + ".threshold";
+  return !spec.options.has(threshold) || spec.options.get_int(threshold, 0, 0, 1 << 24) == 0;
+}
+
 std::unique_ptr<Culler> make_culler(std::string_view name, const SceneIndex& index,
                                     const Options& options) {
   (void)find_algorithm(name);

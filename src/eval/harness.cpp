@@ -247,7 +247,7 @@ FrameStats Session::run_path_frame(Culler& culler, const CameraPath& path, int k
 AlgorithmRun Session::run_path(std::string_view name, Culler& culler, const CameraPath& path,
                                int frames, const std::vector<FrameTruth>* truth,
                                const ProgressFn& progress, bool predict) {
-  AlgorithmRun run{std::string(name), 0, {}, 0};
+  AlgorithmRun run{std::string(name), 0, true, {}, 0};
   run.frames.reserve(std::size_t(frames));
   std::vector<std::uint32_t> miss_run(bundle_.scene.objects().size(), 0);
   std::vector<ObjectId> previously_missed;
@@ -311,6 +311,7 @@ std::vector<AlgorithmSummary> summarize_runs(std::span<const AlgorithmRun> runs)
     std::map<std::string, std::vector<double>> per_repeat;
     for (const AlgorithmRun& r : runs) {
       if (r.name != name) continue;
+      a.conservative = r.conservative;
       const double n = std::max<double>(1.0, double(r.frames.size()));
       std::vector<double> ms;
       std::map<std::string, double> sums;
@@ -382,6 +383,14 @@ std::vector<AlgorithmSummary> summarize_runs(std::span<const AlgorithmRun> runs)
     out.push_back(std::move(a));
   }
   return out;
+}
+
+std::vector<const AlgorithmSummary*> verification_failures(const BenchResult& result) {
+  std::vector<const AlgorithmSummary*> failed;
+  if (!result.verified) return failed;
+  for (const AlgorithmSummary& a : result.summaries)
+    if (a.conservative && a.missed_objects > 0) failed.push_back(&a);
+  return failed;
 }
 
 BenchResult run_bench(const BenchConfig& config, const ProgressFn& progress) {
@@ -472,6 +481,7 @@ BenchResult run_bench(const BenchConfig& config, const ProgressFn& progress) {
                                           },
                                           config.model);
       run.repeat = rep;
+      run.conservative = is_conservative(parse_algorithm_spec(name, config.options));
       result.runs.push_back(std::move(run));
     }
   }

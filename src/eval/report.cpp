@@ -50,6 +50,35 @@ std::string verification_text(const BenchResult& r) {
                      r.truth_probes);
 }
 
+// What verification concluded: failures of conservative runs, popping of the others.
+std::vector<std::string> verdict_lines(const BenchResult& r) {
+  std::vector<std::string> lines;
+  if (!r.verified) return lines;
+  std::string exact, popping;
+  for (const AlgorithmSummary& a : r.summaries) {
+    if (a.conservative) {
+      exact += (exact.empty() ? "" : ", ") + a.name;
+    } else {
+      popping += fmt::format("{}{}: {} missed over {} frames, longest {} frames", popping.empty() ? "" : "; ",
+                             a.name, a.missed_objects, a.frames_with_misses, a.longest_miss_frames);
+    }
+  }
+  const auto failures = verification_failures(r);
+  if (failures.empty()) {
+    if (!exact.empty())
+      lines.push_back(fmt::format("verification passed: the conservative algorithms ({}) missed no visible object", exact));
+  } else {
+    std::string which;
+    for (const AlgorithmSummary* a : failures)
+      which += fmt::format("{}{} missed {} visible objects in {} frames", which.empty() ? "" : "; ", a->name,
+                           a->missed_objects, a->frames_with_misses);
+    lines.push_back("verification FAILED: conservative algorithms culled visible objects: " + which);
+  }
+  if (!popping.empty())
+    lines.push_back("not conservative (may pop by design; misses are popping, not failures): " + popping);
+  return lines;
+}
+
 std::string setup_line(const BenchResult& r) {
   return fmt::format("scene {} ({} objects, {} triangles; BVH {} nodes in {:.1f} ms), path {}, {} frames "
                      "at {}x{}, {} warm-up, {} repeat{}, {}",
@@ -80,6 +109,8 @@ void print_table(const BenchResult& r, std::ostream& out) {
         a.state_changes_per_frame, a.draw_calls_per_frame, a.triangles_per_frame,
         misses_text(r, a.missed_objects), misses_text(r, a.wrong_pixels));
   }
+  if (r.verified) out << "\n";
+  for (const std::string& line : verdict_lines(r)) out << line << "\n";
   if (r.modelled) {
     out << fmt::format("\ncost model (NOHC, profile {}): mean frame ms\n", r.profile_path);
     out << fmt::format("{:<{}} {:>9} {:>10} {:>8}\n", "algorithm", w, "measured", "predicted", "error");
@@ -122,6 +153,7 @@ void write_json(const BenchResult& r, std::ostream& out) {
   ordered_json algos = ordered_json::array();
   for (const AlgorithmSummary& a : r.summaries) {
     algos.push_back({{"name", a.name},
+                     {"conservative", a.conservative},
                      {"frame_ms",
                       {{"mean", a.frame_ms.mean},
                        {"median", a.frame_ms.median},
@@ -238,7 +270,9 @@ std::vector<std::string> write_report(const BenchResult& r, const std::string& d
                       misses_text(r, a.wrong_pixels), misses_text(r, a.longest_miss_frames),
                       a.extra_objects_per_frame, a.wait_ms_per_frame, a.cpu_ms_per_frame);
   }
-  md += "\nFrame times are wall clock, each frame closed by `glFinish`; ratios compare means measured in "
+  md += "\n";
+  for (const std::string& line : verdict_lines(r)) md += "**" + line + "**\n\n";
+  md += "Frame times are wall clock, each frame closed by `glFinish`; ratios compare means measured in "
         "the same run. *missed* counts objects visible in the ground truth (object-id buffer of "
         "everything in the frustum) that the algorithm did not render, summed over frames; *wrong px* "
         "are their pixels; *longest miss* is the longest run of frames one object stayed missed; *extra "
