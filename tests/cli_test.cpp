@@ -270,3 +270,30 @@ TEST(Cli, FirstRunWithAnEmptyCacheCalibratesAndTheOracleDraws) {
     profiles += e.path().extension() == ".json" ? 1 : 0;
   EXPECT_EQ(profiles, 1u) << "the calibrated profile is cached";
 }
+
+TEST(Cli, FpsPlacesFramesAtARealTimeRateAndSaysHowFarTheCameraMoves) {
+  const CliRun spread = run(std::string("bench ") + kTinyCity + " --algo vfc --frames 4 --warmup 0 --no-report");
+  ASSERT_EQ(spread.code, 0) << spread.output;
+  EXPECT_NE(spread.output.find("frames spread over the whole path"), std::string::npos) << spread.output;
+  const CliRun fps = run(std::string("bench ") + kTinyCity +
+                         " --algo vfc --frames 4 --warmup 0 --fps 60 --start 2 --no-report");
+  ASSERT_EQ(fps.code, 0) << fps.output;
+  EXPECT_NE(fps.output.find("frames at 60 fps from 2.0 s of the path"), std::string::npos) << fps.output;
+  // "the camera moves X m": far less at 60 fps than with 4 frames over the path.
+  const auto step = [](const std::string& out) {
+    const auto at = out.find("the camera moves ");
+    return at == std::string::npos ? -1.0 : std::stod(out.substr(at + 17));
+  };
+  EXPECT_GT(step(spread.output), 0.0);
+  EXPECT_GE(step(fps.output), 0.0);
+  EXPECT_LT(step(fps.output), step(spread.output) / 10.0);
+}
+
+TEST(Cli, FramesPastTheEndOfThePathAreRejected) {
+  const CliRun r = run(std::string("bench ") + kTinyCity + " --algo vfc --frames 5000 --fps 60 --start 1 --no-report");
+  EXPECT_EQ(r.code, 2) << r.output;
+  EXPECT_NE(r.output.find("runs past the end of path street"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("frames fit"), std::string::npos) << r.output;
+  EXPECT_EQ(run(std::string("bench ") + kTinyCity + " --algo vfc --fps -3 --no-report").code, 2);
+  EXPECT_EQ(run(std::string("render ") + kTinyCity + " --fps 60 --start 1000 --out /dev/null").code, 2);
+}

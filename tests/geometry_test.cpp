@@ -149,3 +149,15 @@ TEST(CameraPath, YawTakesTheShorterArc) {
                             {1.0, {{0, 0, 0}, glm::radians(-170.0f), 0}, false}});
   EXPECT_NEAR(glm::degrees(path.sample(0.5).yaw), 180.0f, 1e-3f);
 }
+
+TEST(CameraPath, FramesAtAFixedRateFromAStartTime) {
+  CameraPath path("p", "", {{1.0, {{0, 0, 0}, 0, 0}, false}, {5.0, {{4, 0, 0}, 0, 0}, false}});
+  const FrameSampling at_10fps{10.0, 0.5};
+  EXPECT_DOUBLE_EQ(path.frame_time(0, 100, at_10fps), 1.5);  // 0.5 s after the first key
+  EXPECT_DOUBLE_EQ(path.frame_time(7, 100, at_10fps), 2.2);
+  EXPECT_EQ(path.frames_that_fit(at_10fps), 36);              // 1.5 .. 5.0 s
+  EXPECT_EQ(path.frames_that_fit({10.0, 4.0}), 1);
+  EXPECT_EQ(path.frames_that_fit({10.0, 4.5}), 0);
+  EXPECT_EQ(path.frames_that_fit({}), std::numeric_limits<int>::max());  // spread: any number
+  EXPECT_DOUBLE_EQ(path.frame_time(2, 5), 3.0);  // spread: 1, 2, 3, 4, 5
+}

@@ -171,6 +171,8 @@ struct BenchArgs {
   std::string algos;
   int frames = 100;
   int warmup = 8;
+  double fps = 0.0;
+  double start = 0.0;
   std::string size = "1280x720";
   std::vector<std::string> opts;
   std::string query_mode = "samples";
@@ -223,6 +225,7 @@ int cmd_bench(const BenchArgs& a) {
   c.algorithms = split_list(a.algos);
   c.frames = a.frames;
   c.warmup = a.warmup;
+  c.sampling = {a.fps, a.start};
   const Size size = parse_size(a.size);
   c.width = size.width;
   c.height = size.height;
@@ -331,6 +334,8 @@ struct RenderArgs {
   std::string algo = "vfc";
   int frame = 0;
   int frames = 100;
+  double fps = 0.0;
+  double start = 0.0;
   std::string size = "1280x720";
   std::string out = "occull.png";
   std::vector<std::string> opts;
@@ -346,14 +351,20 @@ int cmd_render(const RenderArgs& a) {
   occull::gl::RendererOptions ropts;
   ropts.width = size.width;
   ropts.height = size.height;
+  if (!(a.fps >= 0.0) || !(a.start >= 0.0))
+    throw occull::InputError("--fps and --start must be numbers >= 0");
   occull::Session session(a.scene, ropts);
+  session.set_sampling({a.fps, a.start});
   const auto& path = session.path(a.path);
+  if (a.frame >= path.frames_that_fit(session.sampling()))
+    throw occull::InputError(fmt::format("--frame {} at --fps {} from --start {} s lies past the end of path {} ({:.1f} s)",
+                                         a.frame, a.fps, a.start, path.name(), path.duration()));
   auto culler = occull::make_culler(a.algo, session.index(), options);
   // Run the frames before K too, so cullers with temporal state see the
   // same history they would in a benchmark.
   occull::FrameStats stats;
   for (int k = 0; k <= a.frame; ++k)
-    stats = session.run_frame(*culler, session.view_at(path, k, a.frames), path.frame_time(k, a.frames));
+    stats = session.run_frame(*culler, session.view_at(path, k, a.frames), session.frame_time(path, k, a.frames));
   const auto pixels = session.renderer().read_rgba();
   if (!stbi_write_png(a.out.c_str(), size.width, size.height, 4, pixels.data(), size.width * 4))
     throw occull::InputError(fmt::format("cannot write '{}'", a.out));
@@ -393,6 +404,11 @@ int main(int argc, char** argv) {
                 "name:key=value:key=value (default: all; see occull algos)");
   b->add_option("--frames", bench.frames, "timed frames per algorithm")->capture_default_str();
   b->add_option("--warmup", bench.warmup, "untimed warm-up frames per algorithm")->capture_default_str();
+  b->add_option("--fps", bench.fps,
+                "frames at this rate of path time, as a real-time walk renders them (0: spread the frames "
+                "over the whole path)")
+      ->capture_default_str();
+  b->add_option("--start", bench.start, "with --fps: path time of the first frame, seconds")->capture_default_str();
   b->add_option("--size", bench.size, "render size WIDTHxHEIGHT")->capture_default_str();
   b->add_option("--opt", bench.opts, "algorithm option algo.key=value (repeatable)");
   b->add_option("--query-mode", bench.query_mode, "occlusion query target: samples, any, conservative")
@@ -431,6 +447,9 @@ int main(int argc, char** argv) {
   r->add_option("--frame", render.frame, "frame index K (0-based) of --frames along the path")
       ->capture_default_str();
   r->add_option("--frames", render.frames, "frames the path is divided into")->capture_default_str();
+  r->add_option("--fps", render.fps, "frames at this rate of path time instead (0: divide the path)")
+      ->capture_default_str();
+  r->add_option("--start", render.start, "with --fps: path time of frame 0, seconds")->capture_default_str();
   r->add_option("--size", render.size, "image size WIDTHxHEIGHT")->capture_default_str();
   r->add_option("--out", render.out, "output PNG file")->capture_default_str();
   r->add_option("--opt", render.opts, "algorithm option algo.key=value (repeatable)");

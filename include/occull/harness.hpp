@@ -166,6 +166,13 @@ class Session {
   /// valid names, or naming what is wrong in the file.
   const CameraPath& path(std::string_view name);
 
+  /// Where frames lie on paths (default: spread over the whole path).
+  void set_sampling(const FrameSampling& sampling) { sampling_ = sampling; }
+  [[nodiscard]] const FrameSampling& sampling() const noexcept { return sampling_; }
+  /// Path time of frame k of `frames` under the session's sampling.
+  [[nodiscard]] double frame_time(const CameraPath& path, int k, int frames) const {
+    return path.frame_time(k, frames, sampling_);
+  }
   /// View of `path` at frame k of `frames`.
   [[nodiscard]] View view_at(const CameraPath& path, int k, int frames) const;
 
@@ -190,6 +197,7 @@ class Session {
   std::unique_ptr<gl::Renderer> renderer_;
   std::optional<HardwareProfile> profile_;
   FaultHooks hooks_;
+  FrameSampling sampling_;
 };
 
 struct BenchConfig {
@@ -197,6 +205,7 @@ struct BenchConfig {
   std::string path;                       ///< camera path; empty = the scene's first
   std::vector<std::string> algorithms;    ///< specs (see parse_algorithm_spec); empty = every algorithm
   int frames = 100;                       ///< timed frames per algorithm and repeat, >= 1
+  FrameSampling sampling;                 ///< where they lie on the path (default: spread over it)
   int warmup = 8;                         ///< untimed frames per algorithm and repeat first, >= 0
   int repeat = 1;                         ///< runs of the whole set, interleaved (A B C A B C), >= 1
   bool verify = true;                     ///< check every frame against ground truth
@@ -260,6 +269,11 @@ struct BenchResult {
   double scene_build_ms = 0.0;
   double bvh_build_ms = 0.0;
   int frames = 0;
+  FrameSampling sampling;
+  double path_duration_s = 0.0;
+  /// How far the camera moves and turns from one frame to the next (the
+  /// temporal coherence the cullers see): mean and max, metres and degrees.
+  double step_m_mean = 0.0, step_m_max = 0.0, turn_deg_mean = 0.0, turn_deg_max = 0.0;
   int warmup = 0;
   int repeat = 1;
   bool verified = false;

@@ -45,6 +45,15 @@ struct CameraPose {
 /// Preconditions: width > 0, height > 0, |pitch| < pi/2.
 [[nodiscard]] View make_view(const CameraPose& pose, const Lens& lens, int width, int height);
 
+/// Where the frames of a run lie on a camera path.
+struct FrameSampling {
+  /// Frames per second of path time: frame k is at start_s + k / fps, as a
+  /// real-time walk would render them. 0: the frames are spread evenly over
+  /// the whole path instead (far apart on a long path: less coherent).
+  double fps = 0.0;
+  double start_s = 0.0;  ///< path time of frame 0 when fps > 0, seconds after the first key (>= 0)
+};
+
 /// A keyframed camera path. Poses are interpolated linearly between keys
 /// (yaw along the shorter arc); a key marked `cut` is jumped to without
 /// interpolation (a sudden change of viewpoint).
@@ -67,8 +76,13 @@ class CameraPath {
   [[nodiscard]] double duration() const noexcept;
   /// Pose at `time_s` (clamped to the path's time range).
   [[nodiscard]] CameraPose sample(double time_s) const;
-  /// Time of frame `k` of `frames` spread evenly over the path (frames >= 1).
-  [[nodiscard]] double frame_time(int k, int frames) const noexcept;
+  /// Time of frame `k` of `frames` (frames >= 1): spread evenly over the
+  /// path, or at `sampling.fps` from `sampling.start_s` (not clamped; see
+  /// frames_that_fit).
+  [[nodiscard]] double frame_time(int k, int frames, const FrameSampling& sampling = {}) const noexcept;
+  /// How many frames of `sampling` lie within the path: every one for
+  /// spread sampling (INT_MAX), 0 when start_s is past the end.
+  [[nodiscard]] int frames_that_fit(const FrameSampling& sampling) const noexcept;
 
  private:
   std::string name_;

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cassert>
 #include <cmath>
+#include <limits>
 
 namespace occull {
 
@@ -43,10 +44,19 @@ double CameraPath::duration() const noexcept {
   return keys_.empty() ? 0.0 : keys_.back().time - keys_.front().time;
 }
 
-double CameraPath::frame_time(int k, int frames) const noexcept {
+double CameraPath::frame_time(int k, int frames, const FrameSampling& sampling) const noexcept {
   if (keys_.empty()) return 0.0;
+  if (sampling.fps > 0.0) return keys_.front().time + sampling.start_s + double(k) / sampling.fps;
   if (frames <= 1) return keys_.front().time;
   return keys_.front().time + duration() * double(k) / double(frames - 1);
+}
+
+int CameraPath::frames_that_fit(const FrameSampling& sampling) const noexcept {
+  if (!(sampling.fps > 0.0)) return std::numeric_limits<int>::max();
+  const double room = duration() - sampling.start_s;
+  if (room < 0.0) return 0;
+  // A hair of slack so that a path of exactly n / fps seconds fits n + 1 frames.
+  return int(std::min(std::floor(room * sampling.fps + 1e-9), 1e9)) + 1;
 }
 
 CameraPose CameraPath::sample(double t) const {

@@ -7,6 +7,7 @@
 #include "oracle.hpp"
 
 #include <fmt/format.h>
+#include <glm/gtc/constants.hpp>
 
 #include <algorithm>
 #include <chrono>
@@ -98,7 +99,7 @@ const CameraPath& Session::path(std::string_view name) {
 }
 
 View Session::view_at(const CameraPath& path, int k, int frames) const {
-  return make_view(path.sample(path.frame_time(k, frames)), bundle_.lens, renderer_->width(),
+  return make_view(path.sample(frame_time(path, k, frames)), bundle_.lens, renderer_->width(),
                    renderer_->height());
 }
 
@@ -139,7 +140,7 @@ std::vector<FrameTruth> Session::ground_truth(const CameraPath& path, int frames
   std::vector<ObjectId> in_frustum, outside;
   std::vector<std::uint8_t> drawn(objects.size());
   for (int k = 0; k < frames; ++k) {
-    bundle_.scene.update(path.frame_time(k, frames));
+    bundle_.scene.update(frame_time(path, k, frames));
     const View view = view_at(path, k, frames);
     const detail::FrameLabel where{scene_spec_, path.name(), k};
     in_frustum.clear();
@@ -241,7 +242,7 @@ FrameStats Session::run_path_frame(Culler& culler, const CameraPath& path, int k
     if (hooks_.oracle_objects) hooks_.oracle_objects(visible);
     oracle->set_visible(std::move(visible));
   }
-  return run_frame(culler, view_at(path, k, frames), path.frame_time(k, frames));
+  return run_frame(culler, view_at(path, k, frames), frame_time(path, k, frames));
 }
 
 AlgorithmRun Session::run_path(std::string_view name, Culler& culler, const CameraPath& path,
@@ -413,9 +414,19 @@ BenchResult run_bench(const BenchConfig& config, const ProgressFn& progress) {
   ropts.query_mode = config.query_mode;
   ropts.write_ids = false;  // timed frames draw colour and depth only
   ropts.multi_draw = config.multi_draw;
+  if (config.sampling.fps < 0.0 || !std::isfinite(config.sampling.fps))
+    throw InputError(fmt::format("--fps {}: must be a number >= 0 (0: spread the frames over the path)",
+                                 config.sampling.fps));
+  if (config.sampling.start_s < 0.0 || !std::isfinite(config.sampling.start_s))
+    throw InputError(fmt::format("--start {}: must be a number of seconds >= 0", config.sampling.start_s));
   Session session(config.scene, ropts, config.bvh);
   session.set_fault_hooks(config.hooks);
+  session.set_sampling(config.sampling);
   const CameraPath& path = session.path(config.path);
+  if (const int fit = path.frames_that_fit(config.sampling); config.frames > fit)
+    throw InputError(fmt::format(
+        "--frames {} at --fps {} from --start {} s runs past the end of path {} ({:.1f} s): {} frames fit",
+        config.frames, config.sampling.fps, config.sampling.start_s, path.name(), path.duration(), fit));
   bool uses_profile = config.model;
   std::string profile_path;
   for (const auto& n : names) {
@@ -446,6 +457,19 @@ BenchResult run_bench(const BenchConfig& config, const ProgressFn& progress) {
   result.scene_build_ms = session.scene_build_ms();
   result.bvh_build_ms = session.bvh_build_ms();
   result.frames = config.frames;
+  result.sampling = config.sampling;
+  result.path_duration_s = path.duration();
+  for (int k = 1; k < config.frames; ++k) {
+    const View a = session.view_at(path, k - 1, config.frames), b = session.view_at(path, k, config.frames);
+    const double step = glm::length(b.eye - a.eye);
+    // Forward is -Z of the view: the third row of the view matrix, negated.
+    const glm::vec3 fa(-a.view[0][2], -a.view[1][2], -a.view[2][2]), fb(-b.view[0][2], -b.view[1][2], -b.view[2][2]);
+    const double turn = glm::degrees(std::acos(std::clamp(double(glm::dot(fa, fb)), -1.0, 1.0)));
+    result.step_m_mean += step / double(config.frames - 1);
+    result.turn_deg_mean += turn / double(config.frames - 1);
+    result.step_m_max = std::max(result.step_m_max, step);
+    result.turn_deg_max = std::max(result.turn_deg_max, turn);
+  }
   result.warmup = config.warmup;
   result.repeat = config.repeat;
   result.verified = config.verify;

@@ -79,11 +79,24 @@ std::vector<std::string> verdict_lines(const BenchResult& r) {
   return lines;
 }
 
+std::string sampling_text(const BenchResult& r) {
+  const std::string where =
+      r.sampling.fps > 0.0
+          ? fmt::format("frames at {:g} fps from {:.1f} s of the path ({:.1f} s long)", r.sampling.fps,
+                        r.sampling.start_s, r.path_duration_s)
+          : fmt::format("frames spread over the whole path ({:.1f} s, one every {:.2f} s; --fps F for a "
+                        "real-time walk)",
+                        r.path_duration_s, r.frames > 1 ? r.path_duration_s / double(r.frames - 1) : 0.0);
+  return fmt::format("{}: the camera moves {:.2f} m and turns {:.1f} deg per frame (max {:.2f} m, {:.1f} deg)",
+                     where, r.step_m_mean, r.turn_deg_mean, r.step_m_max, r.turn_deg_max);
+}
+
 std::string setup_line(const BenchResult& r) {
   return fmt::format("scene {} ({} objects, {} triangles; BVH {} nodes in {:.1f} ms), path {}, {} frames "
-                     "at {}x{}, {} warm-up, {} repeat{}, {}",
+                     "at {}x{}, {} warm-up, {} repeat{}, {}\n{}",
                      r.scene, r.objects, r.triangles, r.bvh_nodes, r.bvh_build_ms, r.path, r.frames,
-                     r.width, r.height, r.warmup, r.repeat, r.repeat == 1 ? "" : "s", verification_text(r));
+                     r.width, r.height, r.warmup, r.repeat, r.repeat == 1 ? "" : "s", verification_text(r),
+                     sampling_text(r));
 }
 
 std::string misses_text(const BenchResult& r, std::uint64_t v) {
@@ -142,6 +155,10 @@ void write_json(const BenchResult& r, std::ostream& out) {
                   {"bvh_build_ms", r.bvh_build_ms}};
   doc["path"] = r.path;
   doc["frames"] = r.frames;
+  doc["sampling"] = {{"fps", r.sampling.fps},
+                     {"start_s", r.sampling.start_s},
+                     {"camera_step_m", {{"mean", r.step_m_mean}, {"max", r.step_m_max}}},
+                     {"camera_turn_deg", {{"mean", r.turn_deg_mean}, {"max", r.turn_deg_max}}}};
   doc["warmup"] = r.warmup;
   doc["repeat"] = r.repeat;
   doc["verified"] = r.verified;
@@ -253,6 +270,7 @@ std::vector<std::string> write_report(const BenchResult& r, const std::string& d
                     r.triangles, r.bvh_nodes);
   md += fmt::format("- path: `{}`, {} frames at {}×{}, {} warm-up frames per algorithm\n", r.path, r.frames,
                     r.width, r.height, r.warmup);
+  md += fmt::format("- {}\n", sampling_text(r));
   md += fmt::format("- repeats: {} (algorithms interleaved; figures are medians over repeats)\n", r.repeat);
   md += fmt::format("- {}\n", verification_text(r));
   md += fmt::format("- occull commit: `{}`\n\n## Results\n\n", r.commit);
