@@ -357,3 +357,73 @@ TEST_F(RendererTest, BackFacesStayDrawnAfterAQueryWhenCullingIsOff) {
   EXPECT_EQ(std::count(ids.begin(), ids.end(), 1u), std::ptrdiff_t(ids.size()))
       << "every pixel shows the inside of the box";
 }
+
+namespace {
+
+// 90 degrees on a 64 x 64 target: at 32 m, one metre is one pixel, so box
+// faces there end exactly on pixel boundaries.
+struct PixelGrid {
+  static constexpr int kSide = 64;
+  View view = make_view({{0, 0, 0}, 0, 0}, {90.0f, 0.5f, 100.0f}, kSide, kSide);
+  // A 16 x 16 px box face-on at 32 m (pixels 24..40), 1 m deep.
+  Aabb box{{-8, -8, -33}, {8, 8, -32}};
+};
+
+// Samples of `box`'s query with an occluder in front of it that spans
+// `occluder_half` metres (= pixels) either side of the centre.
+std::uint64_t samples_around_occluder(float margin, float occluder_half, gl::QueryRaster raster) {
+  PixelGrid g;
+  const Scene scene = test::box_scene({{{-occluder_half, -occluder_half, -31}, {occluder_half, occluder_half, -30.5f}}});
+  gl::RendererOptions o;
+  o.width = o.height = PixelGrid::kSide;
+  o.query_margin_px = margin;
+  o.query_raster = raster;
+  gl::Renderer r(scene, o);
+  r.begin_frame(g.view);
+  const ObjectId occluder[] = {0};
+  r.render(occluder);
+  const Aabb box[] = {g.box};
+  const std::uint64_t n = r.result(r.issue_query(box));
+  r.end_frame();
+  return n;
+}
+
+}  // namespace
+
+TEST_F(RendererTest, QueryOutlineWidensByTheMarginSideways) {
+  // The occluder hides exactly the box's 16 x 16 pixels. Pixel centres
+  // outside lie half a pixel beyond its outline: a margin of 0.4 px does
+  // not reach them, 0.6 px reaches the ring of 4 * 16 + 4 around it.
+  EXPECT_EQ(samples_around_occluder(0.4f, 8.0f, gl::QueryRaster::margin), 0u);
+  const std::uint64_t ring = samples_around_occluder(0.6f, 8.0f, gl::QueryRaster::margin);
+  // 68 pixels; near each corner three of them lie in two bands (the bands
+  // are lengthened by the margin too) and count twice: 80 samples.
+  EXPECT_GE(ring, 68u);
+  EXPECT_LE(ring, 80u);
+  EXPECT_EQ(samples_around_occluder(0.6f, 8.0f, gl::QueryRaster::exact), 0u) << "exact boxes are not widened";
+}
+
+TEST_F(RendererTest, WidenedQueryBoxesStayHiddenBehindALargerOccluder) {
+  // The bands keep the depth of the box's edges: an occluder one pixel
+  // larger on every side still hides all of it.
+  EXPECT_EQ(samples_around_occluder(0.6f, 9.0f, gl::QueryRaster::margin), 0u);
+}
+
+TEST_F(RendererTest, ZeroThicknessBoxIsWidenedAlongItsWholeOutline) {
+  // A flat 16 x 16 px box face-on (zero depth), its own face hidden by an
+  // occluder of the same size: only the bands around it can pass.
+  PixelGrid g;
+  const Scene scene = test::box_scene({{{-8, -8, -31}, {8, 8, -30.5f}}});
+  gl::RendererOptions o;
+  o.width = o.height = PixelGrid::kSide;
+  o.query_margin_px = 0.6f;
+  gl::Renderer r(scene, o);
+  r.begin_frame(g.view);
+  const ObjectId occluder[] = {0};
+  r.render(occluder);
+  const Aabb flat[] = {{{-8, -8, -32}, {8, 8, -32}}};
+  const std::uint64_t n = r.result(r.issue_query(flat));
+  r.end_frame();
+  EXPECT_GE(n, 68u);  // as QueryOutlineWidensByTheMarginSideways
+  EXPECT_LE(n, 80u);
+}

@@ -10,6 +10,7 @@
 #include "occull/error.hpp"
 #include "occull/gl/calibrate.hpp"
 #include "occull/gl/context.hpp"
+#include "occull/gl/renderer.hpp"
 #include "occull/profile_io.hpp"
 #include "occull/q3bsp.hpp"
 #include "occull/harness.hpp"
@@ -62,6 +63,14 @@ std::vector<std::string> split_list(const std::string& text) {
   return out;
 }
 
+occull::gl::QueryRaster parse_query_raster(const std::string& s) {
+  if (s == "margin") return occull::gl::QueryRaster::margin;
+  if (s == "hardware") return occull::gl::QueryRaster::hardware;
+  if (s == "exact") return occull::gl::QueryRaster::exact;
+  throw occull::InputError(
+      fmt::format("unknown query raster '{}'; valid values: margin, hardware, exact", s));
+}
+
 occull::gl::QueryMode parse_query_mode(const std::string& s) {
   if (s == "samples") return occull::gl::QueryMode::samples_passed;
   if (s == "any") return occull::gl::QueryMode::any_samples_passed;
@@ -81,6 +90,8 @@ int cmd_info() {
              d.samples_passed_bits, d.any_samples_passed_bits, d.time_elapsed_bits, d.timestamp_bits);
   fmt::print("occlusion queries (GL_SAMPLES_PASSED, GL_ANY_SAMPLES_PASSED[_CONSERVATIVE]), "
              "conditional rendering and timer queries are core in OpenGL 4.5.\n");
+  fmt::print("query boxes are kept conservative by: {}\n",
+             occull::gl::describe_query_raster(occull::gl::RendererOptions{}));
   fmt::print("culling-relevant extensions ({}):\n", d.culling_extensions.size());
   for (const auto& e : d.culling_extensions) fmt::print("  {}\n", e);
   return 0;
@@ -116,9 +127,17 @@ int cmd_scenes() {
     fmt::print("  default: {} objects ({} dynamic), {} triangles\n", bundle.scene.objects().size(),
                bundle.scene.dynamic_objects().size(), bundle.scene.triangle_count());
     fmt::print("  parameters ({}:key=value,...):\n", info.name);
-    for (const auto& p : info.params)
+    for (const auto& p : info.params) {
+      if (!p.choices.empty()) {
+        std::string names;
+        for (const auto& c : p.choices) names += (names.empty() ? "" : " | ") + c;
+        fmt::print("    {:<10} default {:<6} one of {}  {}\n", p.key,
+                   p.choices.at(std::size_t(p.default_value)), names, p.help);
+        continue;
+      }
       fmt::print("    {:<10} default {:<6} range [{}, {}]  {}\n", p.key, p.default_value, p.min,
                  p.max, p.help);
+    }
     fmt::print("  paths:\n");
     for (const auto& path : bundle.paths)
       fmt::print("    {:<10} {:.1f} s  {}\n", path.name(), path.duration(), path.description());
@@ -176,6 +195,8 @@ struct BenchArgs {
   std::string size = "1280x720";
   std::vector<std::string> opts;
   std::string query_mode = "samples";
+  std::string query_raster = "margin";
+  float query_margin = occull::gl::RendererOptions{}.query_margin_px;
   std::string draw = "single";
   int bvh_leaf = occull::BvhOptions{}.max_leaf_objects;
   int repeat = 1;
@@ -231,6 +252,8 @@ int cmd_bench(const BenchArgs& a) {
   c.height = size.height;
   c.options = parse_options(a.opts);
   c.query_mode = parse_query_mode(a.query_mode);
+  c.query_raster = parse_query_raster(a.query_raster);
+  c.query_margin_px = a.query_margin;
   c.multi_draw = parse_draw_mode(a.draw);
   c.repeat = a.repeat;
   if (a.bvh_leaf < 1 || a.bvh_leaf > 64)
@@ -412,6 +435,12 @@ int main(int argc, char** argv) {
   b->add_option("--size", bench.size, "render size WIDTHxHEIGHT")->capture_default_str();
   b->add_option("--opt", bench.opts, "algorithm option algo.key=value (repeatable)");
   b->add_option("--query-mode", bench.query_mode, "occlusion query target: samples, any, conservative")
+      ->capture_default_str();
+  b->add_option("--query-raster", bench.query_raster,
+                "how query boxes stay conservative beyond sub-pixel snapping: margin (widen their outline "
+                "by --query-margin px), hardware (conservative-raster extension, else margin), exact (neither)")
+      ->capture_default_str();
+  b->add_option("--query-margin", bench.query_margin, "with --query-raster margin: pixels to widen each query box's outline by")
       ->capture_default_str();
   b->add_option("--repeat", bench.repeat, "run the whole set R times, interleaved; report medians")
       ->capture_default_str();

@@ -213,6 +213,8 @@ struct BenchConfig {
   int height = 720;
   Options options;
   gl::QueryMode query_mode = gl::QueryMode::samples_passed;
+  gl::QueryRaster query_raster = gl::QueryRaster::margin;  ///< see gl::RendererOptions
+  float query_margin_px = gl::RendererOptions{}.query_margin_px;
   bool multi_draw = false;                ///< see gl::RendererOptions::multi_draw
   BvhOptions bvh;                         ///< how the scene's hierarchy is built
   bool model = false;                     ///< also predict each frame with the NOHC cost model
@@ -283,6 +285,7 @@ struct BenchResult {
   std::string profile_path;       ///< the hardware profile used (when modelled or nohc ran)
   int width = 0;
   int height = 0;
+  std::string query_geometry;                ///< how query boxes were kept conservative (describe_query_raster)
   std::vector<AlgorithmRun> runs;            ///< in execution order
   std::vector<AlgorithmSummary> summaries;   ///< one per algorithm, in the order asked
 };

@@ -21,6 +21,9 @@ struct SceneParamInfo {
   double max = 0.0;
   bool integer = true;
   std::string help;
+  /// When not empty, the parameter is one of these names (its value is the
+  /// index of the name; min/max are 0 and choices.size() - 1).
+  std::vector<std::string> choices;
 };
 
 struct SceneInfo {

@@ -414,6 +414,10 @@ BenchResult run_bench(const BenchConfig& config, const ProgressFn& progress) {
   ropts.query_mode = config.query_mode;
   ropts.write_ids = false;  // timed frames draw colour and depth only
   ropts.multi_draw = config.multi_draw;
+  ropts.query_raster = config.query_raster;
+  ropts.query_margin_px = config.query_margin_px;
+  if (!(config.query_margin_px >= 0.0f && config.query_margin_px <= 16.0f))
+    throw InputError(fmt::format("--query-margin {}: must be in [0, 16] pixels", config.query_margin_px));
   if (config.sampling.fps < 0.0 || !std::isfinite(config.sampling.fps))
     throw InputError(fmt::format("--fps {}: must be a number >= 0 (0: spread the frames over the path)",
                                  config.sampling.fps));
@@ -477,6 +481,7 @@ BenchResult run_bench(const BenchConfig& config, const ProgressFn& progress) {
   result.profile_path = profile_path;
   result.width = config.width;
   result.height = config.height;
+  result.query_geometry = gl::describe_query_raster(ropts);
 
   std::vector<FrameTruth> truth;
   if (config.verify) truth = session.ground_truth(path, config.frames, progress);

@@ -114,7 +114,12 @@ std::size_t check_truth_probes(const FrameLabel& where, const Scene& scene, cons
   // its own or nearer. Computed on the CPU from the scene alone.
   const double w = view.width, h = view.height;
   constexpr double kInside = 0.5;      // pixels from every edge: far beyond any vertex snapping
-  constexpr double kDepthSlack = 1e-6; // window depth: ~16 ulps near 1, far above interpolation error
+  // Depth slack: the rasteriser evaluates the depth plane of snapped vertices
+  // in float, so allow ~16 ulps near 1 plus the depth change over a tenth of
+  // a pixel along the triangle's own depth gradient (steep triangles near
+  // the eye change depth fast across a pixel).
+  constexpr double kDepthSlack = 1e-6;
+  constexpr double kSnapPixels = 0.1;
   // Largest on screen first: their triangles are the likeliest to qualify.
   std::vector<std::pair<double, ObjectId>> candidates;
   for (ObjectId id : drawn) {
@@ -163,9 +168,12 @@ std::size_t check_truth_probes(const FrameLabel& where, const Scene& scene, cons
       }
       if (!inside) continue;
       const double z_tri = lambda[0] * z[0] + lambda[1] * z[1] + lambda[2] * z[2];
-      if (z_tri > 1.0 - 10.0 * kDepthSlack) continue;  // too close to the far plane to tell from nothing
+      const double dz_dx = ((z[1] - z[0]) * (p[2].y - p[0].y) - (z[2] - z[0]) * (p[1].y - p[0].y)) / area2;
+      const double dz_dy = ((z[2] - z[0]) * (p[1].x - p[0].x) - (z[1] - z[0]) * (p[2].x - p[0].x)) / area2;
+      const double slack = kDepthSlack + kSnapPixels * (std::abs(dz_dx) + std::abs(dz_dy));
+      if (z_tri + slack > 1.0 - kDepthSlack) continue;  // too close to the far plane to tell from nothing
       const float z_buf = depth[std::size_t(py) * std::size_t(view.width) + std::size_t(px)];
-      if (double(z_buf) > z_tri + kDepthSlack)
+      if (double(z_buf) > z_tri + slack)
         invariant_violated(
             where, "truth-probe",
             fmt::format("triangle {} of object {} covers pixel ({}, {}) at window depth {:.7f}, but the truth "

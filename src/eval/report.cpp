@@ -107,7 +107,8 @@ std::string misses_text(const BenchResult& r, std::uint64_t v) {
 
 void print_table(const BenchResult& r, std::ostream& out) {
   out << setup_line(r) << "\n";
-  out << fmt::format("device: {} | {} | occull {}\n\n", r.device.renderer, r.device.version, r.commit);
+  out << fmt::format("device: {} | {} | occull {}\nquery boxes: {}\n\n", r.device.renderer, r.device.version,
+                     r.commit, r.query_geometry);
   std::size_t w = 10;
   for (const AlgorithmSummary& a : r.summaries) w = std::max(w, a.name.size());
   out << fmt::format("{:<{}} {:>8} {:>8} {:>8} {:>8} {:>6} {:>7} {:>8} {:>7} {:>7} {:>10} {:>7} {:>9}\n",
@@ -167,6 +168,7 @@ void write_json(const BenchResult& r, std::ostream& out) {
   doc["modelled"] = r.modelled;
   if (!r.profile_path.empty()) doc["hardware_profile"] = r.profile_path;
   doc["size"] = {r.width, r.height};
+  doc["query_geometry"] = r.query_geometry;
   ordered_json algos = ordered_json::array();
   for (const AlgorithmSummary& a : r.summaries) {
     algos.push_back({{"name", a.name},
@@ -273,6 +275,7 @@ std::vector<std::string> write_report(const BenchResult& r, const std::string& d
   md += fmt::format("- {}\n", sampling_text(r));
   md += fmt::format("- repeats: {} (algorithms interleaved; figures are medians over repeats)\n", r.repeat);
   md += fmt::format("- {}\n", verification_text(r));
+  md += fmt::format("- query boxes: {}\n", r.query_geometry);
   md += fmt::format("- occull commit: `{}`\n\n## Results\n\n", r.commit);
   md += "| algorithm | mean ms | median | p95 | max | vs vfc | vs oracle | queries | state changes | "
         "draws | triangles | missed | frames w/ miss | wrong px | longest miss | extra objects | "

@@ -4,10 +4,13 @@
 
 #include <glm/gtc/type_ptr.hpp>
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cassert>
 #include <chrono>
 #include <stdexcept>
+#include <string_view>
 
 namespace occull::gl {
 namespace {
@@ -90,12 +93,60 @@ void main() {
 }
 )";
 
+// Query boxes (their depth offset is set in enter_query_state): the box's
+// faces (a_band.x == 0), then a band along each of
+// its 12 edges (a_band.x == 1) that is widened to u_margin pixels on either
+// side, and lengthened by as much at both ends, when the edge lies on the
+// box's silhouette — between a face that faces the eye and one that does
+// not, a face of zero area never facing it (a zero-thickness box). The band
+// keeps the depth of its edge: it widens the box's outline on screen without
+// moving it toward the eye. Other bands collapse to zero area.
 const char* kQueryVertex = R"(#version 450 core
-layout(location = 0) in vec3 a_corner;
+layout(location = 0) in vec3 a_p;     // the box corner of this vertex (0/1 per axis); a band's first end
+layout(location = 1) in vec3 a_q;     // a band's second end
+layout(location = 2) in vec3 a_band;  // x: 1 on a band; y: 1 at the second end; z: side, -1 or +1
 layout(location = 3) in vec3 a_min;
 layout(location = 4) in vec3 a_max;
 uniform mat4 u_view_proj;
-void main() { gl_Position = u_view_proj * vec4(mix(a_min, a_max, a_corner), 1.0); }
+uniform vec3 u_eye;
+uniform vec2 u_half_viewport;  // pixels
+uniform float u_margin;        // pixels
+
+// The face on `axis` at its max (hi) or min side faces the eye and has area.
+bool facing(int axis, bool hi, vec3 extent) {
+  bool faces = hi ? u_eye[axis] > a_max[axis] : u_eye[axis] < a_min[axis];
+  return faces && extent[(axis + 1) % 3] > 0.0 && extent[(axis + 2) % 3] > 0.0;
+}
+
+void main() {
+  vec4 a = u_view_proj * vec4(mix(a_min, a_max, a_p), 1.0);
+  if (a_band.x == 0.0) {
+    gl_Position = a;
+    return;
+  }
+  vec4 b = u_view_proj * vec4(mix(a_min, a_max, a_q), 1.0);
+  bool at_b = a_band.y > 0.5;
+  int e = a_p.x != a_q.x ? 0 : (a_p.y != a_q.y ? 1 : 2);  // the edge's axis
+  int f = (e + 1) % 3, g = (e + 2) % 3;                   // its two faces' axes
+  vec3 extent = a_max - a_min;
+  const float min_w = 1e-5;
+  bool silhouette = facing(f, a_p[f] > 0.5, extent) != facing(g, a_p[g] > 0.5, extent);
+  if (u_margin <= 0.0 || !silhouette || max(a.w, b.w) <= min_w) {
+    gl_Position = at_b ? b : a;  // a band of zero area
+    return;
+  }
+  // The part of the edge in front of the eye.
+  if (a.w < min_w) a = mix(a, b, (min_w - a.w) / (b.w - a.w));
+  if (b.w < min_w) b = mix(b, a, (min_w - b.w) / (a.w - b.w));
+  vec2 d = (b.xy / b.w - a.xy / a.w) * u_half_viewport;
+  float len = length(d);
+  vec2 t = len > 1e-6 ? d / len : vec2(1.0, 0.0);
+  vec2 n = vec2(-t.y, t.x);  // with t, counter-clockwise: the band is front-facing
+  vec4 here = at_b ? b : a;
+  vec2 offset = u_margin * (a_band.z * n + (at_b ? t : -t));
+  here.xy += offset / u_half_viewport * here.w;
+  gl_Position = here;
+}
 )";
 
 const char* kQueryFragment = R"(#version 450 core
@@ -142,6 +193,38 @@ void bind_for_reading(GLuint fbo, GLint alignment) {
   glPixelStorei(GL_PACK_SKIP_PIXELS, 0);
 }
 
+// The query mesh: the 36 vertices of a unit cube's faces (outward,
+// counter-clockwise; corner i has bit 0 = x, bit 1 = y, bit 2 = z, as
+// Aabb::corner), then 6 per edge for its silhouette band (see kQueryVertex).
+struct QueryVertex {
+  glm::vec3 p, q, band;
+};
+std::vector<QueryVertex> query_mesh() {
+  const auto corner = [](int i) { return glm::vec3(float(i & 1), float((i >> 1) & 1), float((i >> 2) & 1)); };
+  static constexpr int faces[36] = {0, 2, 3, 0, 3, 1,  4, 5, 7, 4, 7, 6,  0, 4, 6, 0, 6, 2,
+                                    1, 3, 7, 1, 7, 5,  0, 1, 5, 0, 5, 4,  2, 6, 7, 2, 7, 3};
+  std::vector<QueryVertex> v;
+  for (int i : faces) v.push_back({corner(i), corner(i), {0, 0, 0}});
+  for (int axis = 0; axis < 3; ++axis)
+    for (int others = 0; others < 4; ++others) {
+      // The corner with bit `axis` clear and the other two bits from `others`, and its partner.
+      const int low = axis == 0 ? others << 1 : axis == 1 ? (others & 1) | ((others & 2) << 1) : others;
+      const glm::vec3 p = corner(low), q = corner(low | (1 << axis));
+      // (p,-) (q,-) (q,+)  (p,-) (q,+) (p,+)
+      for (const auto& [end, side] : {std::pair{0.f, -1.f}, {1.f, -1.f}, {1.f, 1.f}, {0.f, -1.f}, {1.f, 1.f}, {0.f, 1.f}})
+        v.push_back({p, q, {1.0f, end, side}});
+    }
+  return v;
+}
+
+bool has_extension(const char* name) {
+  GLint n = 0;
+  glGetIntegerv(GL_NUM_EXTENSIONS, &n);
+  for (GLint i = 0; i < n; ++i)
+    if (std::string_view(reinterpret_cast<const char*>(glGetStringi(GL_EXTENSIONS, GLuint(i)))) == name) return true;
+  return false;
+}
+
 }  // namespace
 
 struct Renderer::Impl {
@@ -153,9 +236,13 @@ struct Renderer::Impl {
   GLuint object_buffer = 0, material_buffer = 0;
   GLuint scene_vao = 0, scene_program = 0;
   GLint u_scene_view_proj = -1, u_material = -1, u_eye = -1, u_background = -1, u_fog = -1;
-  GLuint cube_vertices = 0, cube_indices = 0, box_buffer = 0;
+  GLuint cube_vertices = 0, box_buffer = 0;
   GLuint query_vao = 0, query_program = 0;
-  GLint u_query_view_proj = -1;
+  GLint u_query_view_proj = -1, u_query_eye = -1, u_query_half_viewport = -1, u_query_margin = -1;
+  QueryRaster query_raster = QueryRaster::margin;  // what is in effect (hardware falls back to margin)
+  GLenum conservative_cap = 0;                     // GL_CONSERVATIVE_RASTERIZATION_{NV,INTEL} when present
+  GLsizei query_vertices = 36;                     // faces only, or faces and silhouette bands
+  float query_slope_px = 0.0f;                     // polygon-offset slope factor of query boxes
   GLuint fbo = 0, color_rb = 0, depth_rb = 0, id_rb = 0;
   GLuint timer = 0;
   bool timer_supported = false;
@@ -302,32 +389,53 @@ void Renderer::Impl::create_scene_buffers() {
   u_fog = glGetUniformLocation(scene_program, "u_fog_distance");
 }
 
-void Renderer::Impl::create_query_resources() {
-  // Unit cube: corner i has bit 0 = x, bit 1 = y, bit 2 = z (as Aabb::corner).
-  float corners[8 * 3];
-  for (int i = 0; i < 8; ++i) {
-    corners[i * 3 + 0] = float(i & 1);
-    corners[i * 3 + 1] = float((i >> 1) & 1);
-    corners[i * 3 + 2] = float((i >> 2) & 1);
+QueryRaster effective_query_raster(QueryRaster requested) {
+  if (requested != QueryRaster::hardware) return requested;
+  return has_extension("GL_NV_conservative_raster") || has_extension("GL_INTEL_conservative_rasterization")
+             ? QueryRaster::hardware
+             : QueryRaster::margin;
+}
+
+std::string describe_query_raster(const RendererOptions& options) {
+  switch (effective_query_raster(options.query_raster)) {
+    case QueryRaster::hardware:
+      return fmt::format("hardware conservative rasterization ({}), depth pulled {:g} px of its slope toward the eye",
+                         has_extension("GL_NV_conservative_raster") ? "GL_NV_conservative_raster"
+                                                                    : "GL_INTEL_conservative_rasterization",
+                         options.query_margin_px);
+    case QueryRaster::exact: return "exact boxes, no margin (can miss one-pixel objects)";
+    case QueryRaster::margin: break;
   }
-  // Outward counter-clockwise faces: query boxes are drawn with back faces
-  // culled (unless a box is around the eye).
-  const GLubyte idx[36] = {0, 2, 3, 0, 3, 1,  4, 5, 7, 4, 7, 6,  0, 4, 6, 0, 6, 2,
-                           1, 3, 7, 1, 7, 5,  0, 1, 5, 0, 5, 4,  2, 6, 7, 2, 7, 3};
+  GLint bits = 0;
+  glGetIntegerv(GL_SUBPIXEL_BITS, &bits);
+  return fmt::format("outline widened by {0:g} px and depth pulled {0:g} px of its slope toward the eye "
+                     "(rasteriser snaps vertices to 1/{1} px){2}",
+                     options.query_margin_px, 1 << std::clamp(bits, 0, 30),
+                     options.query_raster == QueryRaster::hardware ? "; no conservative-raster extension" : "");
+}
+
+void Renderer::Impl::create_query_resources() {
+  query_raster = effective_query_raster(options.query_raster);
+  if (query_raster == QueryRaster::hardware)
+    conservative_cap = has_extension("GL_NV_conservative_raster") ? GL_CONSERVATIVE_RASTERIZATION_NV
+                                                                  : GL_CONSERVATIVE_RASTERIZATION_INTEL;
+  const std::vector<QueryVertex> mesh = query_mesh();
+  query_vertices = query_raster == QueryRaster::margin && options.query_margin_px > 0.0f ? GLsizei(mesh.size()) : 36;
+  query_slope_px = query_raster == QueryRaster::exact ? 0.0f : std::max(0.0f, options.query_margin_px);
   glCreateBuffers(1, &cube_vertices);
-  glNamedBufferStorage(cube_vertices, sizeof(corners), corners, 0);
-  glCreateBuffers(1, &cube_indices);
-  glNamedBufferStorage(cube_indices, sizeof(idx), idx, 0);
+  glNamedBufferStorage(cube_vertices, GLsizeiptr(mesh.size() * sizeof(QueryVertex)), mesh.data(), 0);
   glCreateBuffers(1, &indirect_buffer);
   glCreateBuffers(1, &box_buffer);
   glNamedBufferData(box_buffer, kBoxCapacity * GLsizeiptr(sizeof(Aabb)), nullptr, GL_STREAM_DRAW);
   static_assert(sizeof(Aabb) == 6 * sizeof(float), "Aabb is uploaded as two vec3");
 
   glCreateVertexArrays(1, &query_vao);
-  glVertexArrayVertexBuffer(query_vao, 0, cube_vertices, 0, 3 * sizeof(float));
-  glVertexArrayAttribFormat(query_vao, 0, 3, GL_FLOAT, GL_FALSE, 0);
-  glVertexArrayAttribBinding(query_vao, 0, 0);
-  glEnableVertexArrayAttrib(query_vao, 0);
+  glVertexArrayVertexBuffer(query_vao, 0, cube_vertices, 0, sizeof(QueryVertex));
+  for (GLuint a = 0; a < 3; ++a) {
+    glVertexArrayAttribFormat(query_vao, a, 3, GL_FLOAT, GL_FALSE, a * sizeof(glm::vec3));
+    glVertexArrayAttribBinding(query_vao, a, 0);
+    glEnableVertexArrayAttrib(query_vao, a);
+  }
   glVertexArrayVertexBuffer(query_vao, 1, box_buffer, 0, sizeof(Aabb));
   glVertexArrayBindingDivisor(query_vao, 1, 1);
   glVertexArrayAttribFormat(query_vao, 3, 3, GL_FLOAT, GL_FALSE, 0);
@@ -336,10 +444,15 @@ void Renderer::Impl::create_query_resources() {
   glVertexArrayAttribBinding(query_vao, 4, 1);
   glEnableVertexArrayAttrib(query_vao, 3);
   glEnableVertexArrayAttrib(query_vao, 4);
-  glVertexArrayElementBuffer(query_vao, cube_indices);
 
   query_program = make_program("query", kQueryVertex, kQueryFragment);
   u_query_view_proj = glGetUniformLocation(query_program, "u_view_proj");
+  u_query_eye = glGetUniformLocation(query_program, "u_eye");
+  u_query_half_viewport = glGetUniformLocation(query_program, "u_half_viewport");
+  u_query_margin = glGetUniformLocation(query_program, "u_margin");
+  glProgramUniform2f(query_program, u_query_half_viewport, 0.5f * float(options.width), 0.5f * float(options.height));
+  glProgramUniform1f(query_program, u_query_margin,
+                     query_vertices > 36 ? std::max(0.0f, options.query_margin_px) : 0.0f);
 
   GLint bits = 0;
   glGetQueryiv(GL_TIME_ELAPSED, GL_QUERY_COUNTER_BITS, &bits);
@@ -365,6 +478,7 @@ void Renderer::Impl::establish_frame_state() const {
                      GL_PRIMITIVE_RESTART_FIXED_INDEX})
     glDisable(cap);
   for (GLenum i = 0; i < 8; ++i) glDisable(GL_CLIP_DISTANCE0 + i);  // shaders write none
+  if (conservative_cap) glDisable(conservative_cap);
   glEnable(GL_DEPTH_TEST);
   glPolygonMode(GL_FRONT_AND_BACK, GL_FILL);
   glFrontFace(GL_CCW);
@@ -391,6 +505,7 @@ void Renderer::Impl::enter_render_state(BackendStats& stats) {
   glDisable(GL_POLYGON_OFFSET_FILL);
   // The query pass culls back faces: set culling both ways.
   if (options.cull_backfaces) glEnable(GL_CULL_FACE); else glDisable(GL_CULL_FACE);
+  if (conservative_cap) glDisable(conservative_cap);
 }
 
 void Renderer::Impl::enter_query_state(BackendStats& stats) {
@@ -404,9 +519,15 @@ void Renderer::Impl::enter_query_state(BackendStats& stats) {
   glDepthFunc(GL_LEQUAL);
   glEnable(GL_DEPTH_CLAMP);
   glEnable(GL_POLYGON_OFFSET_FILL);
-  glPolygonOffset(0.0f, -2.0f);  // units only: a slope term would pull edge-on faces through walls
+  // Toward the eye by 2 depth units, plus the depth change of query_slope_px
+  // pixels along the face's own slope: a box face coplanar with its object
+  // (a decal on the ground) interpolates depth from other vertex positions,
+  // which snapping moves by a fraction of a pixel; at grazing angles that
+  // fraction is worth more depth than any constant offset.
+  glPolygonOffset(-query_slope_px, -2.0f);
   glEnable(GL_CULL_FACE);  // front faces cover every visible pixel of a box the eye is outside of
   query_culls_back = true;
+  if (conservative_cap) glEnable(conservative_cap);
 }
 
 void Renderer::Impl::draw_objects(std::span<const ObjectId> ids, BackendStats& stats) {
@@ -485,9 +606,9 @@ Renderer::~Renderer() {
     glDeleteQueries(GLsizei(g.query_names.size()), g.query_names.data());
   if (g.timer) glDeleteQueries(1, &g.timer);
   glDeleteQueries(1, &g.truth_query);
-  const GLuint buffers[] = {g.vertex_buffer, g.index_buffer, g.object_index_buffer,
+  const GLuint buffers[] = {g.vertex_buffer, g.index_buffer,  g.object_index_buffer,
                             g.object_buffer, g.material_buffer, g.cube_vertices,
-                            g.cube_indices,  g.box_buffer,          g.indirect_buffer};
+                            g.box_buffer,    g.indirect_buffer};
   glDeleteBuffers(GLsizei(std::size(buffers)), buffers);
   const GLuint vaos[] = {g.scene_vao, g.query_vao};
   glDeleteVertexArrays(2, vaos);
@@ -505,6 +626,7 @@ void Renderer::Impl::prepare_pass(const View& view) {
   upload_dynamic_transforms();
   glProgramUniformMatrix4fv(scene_program, u_scene_view_proj, 1, GL_FALSE, glm::value_ptr(view.view_proj));
   glProgramUniformMatrix4fv(query_program, u_query_view_proj, 1, GL_FALSE, glm::value_ptr(view.view_proj));
+  glProgramUniform3fv(query_program, u_query_eye, 1, glm::value_ptr(view.eye));
   glProgramUniform3fv(scene_program, u_eye, 1, glm::value_ptr(view.eye));
   glProgramUniform3fv(scene_program, u_background, 1, glm::value_ptr(options.background));
   glProgramUniform1f(scene_program, u_fog, std::max(view.far, 1.0f));
@@ -625,8 +747,7 @@ QueryId Renderer::issue_query(std::span<const Aabb> boxes) {
     const auto n = std::min<std::size_t>(boxes.size() - done, std::size_t(kBoxCapacity - g.box_offset));
     glNamedBufferSubData(g.box_buffer, g.box_offset * GLsizeiptr(sizeof(Aabb)),
                          GLsizeiptr(n * sizeof(Aabb)), boxes.data() + done);
-    glDrawElementsInstancedBaseInstance(GL_TRIANGLES, 36, GL_UNSIGNED_BYTE, nullptr, GLsizei(n),
-                                        GLuint(g.box_offset));
+    glDrawArraysInstancedBaseInstance(GL_TRIANGLES, 0, g.query_vertices, GLsizei(n), GLuint(g.box_offset));
     g.box_offset += GLsizeiptr(n);
     done += n;
   }

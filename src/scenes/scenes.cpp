@@ -21,6 +21,7 @@ const std::vector<Generator>& generators() {
   static const std::vector<Generator> all = {
       {scenes::city_info(), &scenes::make_city},
       {scenes::field_info(), &scenes::make_field},
+      {scenes::adversarial_info(), &scenes::make_adversarial},
   };
   return all;
 }
@@ -38,6 +39,15 @@ std::string param_names(const SceneInfo& info) {
 }
 
 double parse_number(std::string_view text, const SceneInfo& info, const SceneParamInfo& p) {
+  if (!p.choices.empty()) {
+    std::string names;
+    for (std::size_t i = 0; i < p.choices.size(); ++i) {
+      if (p.choices[i] == text) return double(i);
+      names += (names.empty() ? "" : ", ") + p.choices[i];
+    }
+    throw InputError(fmt::format("scene {}: parameter {}: unknown value '{}'; valid values: {}", info.name,
+                                 p.key, text, names));
+  }
   double v = 0.0;
   const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), v);
   if (ec != std::errc() || end != text.data() + text.size() || !std::isfinite(v))

@@ -17,4 +17,7 @@ SceneBundle make_city(const Params& params);
 SceneInfo field_info();
 SceneBundle make_field(const Params& params);
 
+SceneInfo adversarial_info();
+SceneBundle make_adversarial(const Params& params);
+
 }  // namespace occull::scenes

@@ -8,6 +8,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <string>
 #include <vector>
 
 namespace occull::gl {
@@ -17,6 +18,26 @@ enum class QueryMode : std::uint8_t {
   samples_passed,                   ///< GL_SAMPLES_PASSED: exact sample counts
   any_samples_passed,               ///< GL_ANY_SAMPLES_PASSED: 0 or 1
   any_samples_passed_conservative,  ///< GL_ANY_SAMPLES_PASSED_CONSERVATIVE: 0 or 1, may overestimate
+};
+
+/// How query boxes stay conservative beyond the rasteriser's sub-pixel
+/// vertex snapping. A box of zero thickness (a decal, a flat panel) has
+/// exactly its object's outline, and snapping can put a pixel centre inside
+/// the object's triangles but outside the box's face: the query then counts
+/// 0 samples for a visible object.
+enum class QueryRaster : std::uint8_t {
+  /// Widen each box's outline on screen by RendererOptions::query_margin_px:
+  /// a band along every silhouette edge, at that edge's depth — sideways,
+  /// not toward the eye, so a box lying on a surface is not lifted above it
+  /// (its depth moves only by the slope term of query_margin_px). Works on
+  /// every driver (the default).
+  margin,
+  /// GL_NV_conservative_raster or GL_INTEL_conservative_rasterization: every
+  /// pixel a box face touches. Falls back to `margin` without either.
+  hardware,
+  /// The boxes as the rasteriser draws them: not conservative at sub-pixel
+  /// precision (to measure what the margin costs).
+  exact,
 };
 
 struct RendererOptions {
@@ -32,7 +53,24 @@ struct RendererOptions {
   /// instead of one draw per object (same pixels; less driver overhead per object).
   bool multi_draw = false;
   glm::vec3 background{0.62f, 0.74f, 0.86f};
+  QueryRaster query_raster = QueryRaster::margin;
+  /// The sub-pixel error query boxes absorb, in pixels. With `margin`, each
+  /// box's outline is widened (and its silhouette edges lengthened) on screen
+  /// by this much; with `margin` and `hardware`, its depth is pulled toward
+  /// the eye by this many pixels' worth of its own depth slope (a polygon
+  /// offset factor), so a face coplanar with its object (a decal) passes
+  /// where the object does. See README, "Conservative query geometry", for
+  /// the measurements behind the default.
+  float query_margin_px = 0.125f;
 };
+
+/// What `requested` amounts to on the current context: `hardware` becomes
+/// `margin` without a conservative-raster extension. Precondition: a
+/// gl::Context is current.
+[[nodiscard]] QueryRaster effective_query_raster(QueryRaster requested);
+/// One line saying how query boxes are kept conservative with `options` on
+/// the current context (occull info). Precondition: a gl::Context is current.
+[[nodiscard]] std::string describe_query_raster(const RendererOptions& options);
 
 /// The reference renderer. Draws a Scene into an offscreen framebuffer with
 /// a colour (RGBA8), a depth (32-bit float) and an object-id (R32UI)
