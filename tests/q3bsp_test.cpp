@@ -66,22 +66,38 @@ TEST(Q3Bsp, SceneConvertsToMetresAndYUp) {
   EXPECT_NEAR(s.paths.front().keys().front().pose.position.y, 50.0f / 32.0f, 1e-4f);  // eye height
 }
 
-TEST(Q3Bsp, SkyIsLeftOutAndWaterIsTranslucent) {
+TEST(Q3Bsp, SkyIsOpaqueNoDrawIsLeftOutAndWaterIsTranslucent) {
+  // Sky surfaces are drawn in the game (the sky box is painted on them) and
+  // hide what lies behind them; no-draw surfaces are invisible.
   auto b = test::TinyBsp::example();
-  b.textures = {{"textures/skies/blue", 1}, {"textures/liquids/water", 32}};
-  b.faces[0][0] = 0;
-  b.faces[1][0] = 1;
+  b.textures = {{"textures/skies/blue", 1}, {"textures/liquids/water", 32}, {"textures/common/nodraw", 1}};
+  b.faces[0][0] = 0;  // the quad: sky
+  b.faces[1][0] = 1;  // the patch: water
+  b.faces.push_back(b.faces[0]);
+  b.faces.back()[0] = 2;  // the quad again: no-draw
   auto bytes = b.bytes();
-  // Mark texture 0 as sky (surface flags at byte 64 of its record).
+  // Surface flags sit at byte 64 of each 72-byte texture record.
   const std::size_t textures_at = std::size_t(std::to_integer<int>(bytes[16])) |
                                   std::size_t(std::to_integer<int>(bytes[17])) << 8;
   test::TinyBsp::put(bytes, textures_at + 64, q3::kSurfSky);
+  test::TinyBsp::put(bytes, textures_at + 2 * 72 + 64, q3::kSurfNoDraw);
   const SceneBundle s = q3::build_scene(q3::read_bsp(bytes, "sky.bsp"), "sky", {2, 1500});
-  EXPECT_EQ(s.scene.triangle_count(), 8u);  // only the patch
+  EXPECT_EQ(s.scene.triangle_count(), 10u);  // the sky quad and the patch, not the no-draw quad
+  std::size_t opaque = 0, translucent = 0;
   for (const auto& o : s.scene.objects()) {
-    EXPECT_TRUE(s.scene.material(o.material).translucent);
-    EXPECT_EQ(o.occluder, OccluderClass::never);
+    const Material& m = s.scene.material(o.material);
+    if (m.translucent) {
+      ++translucent;
+      EXPECT_EQ(o.occluder, OccluderClass::never);
+      EXPECT_EQ(m.name, "textures/liquids/water");
+    } else {
+      ++opaque;
+      EXPECT_EQ(m.name, "textures/skies/blue");
+      EXPECT_EQ(o.occluder, OccluderClass::always);
+    }
   }
+  EXPECT_EQ(opaque, 1u);
+  EXPECT_EQ(translucent, 1u);
 }
 
 namespace {

@@ -48,6 +48,26 @@ struct Leaf {
   std::int32_t first_face = 0, face_count = 0;
 };
 
+struct Plane {
+  glm::vec3 normal;  ///< Quake coordinates
+  float dist = 0.0f; ///< points p with dot(normal, p) == dist lie on it
+};
+
+/// BSP node: points in front of its plane (dot(normal, p) >= dist) go to
+/// children[0]. A child >= 0 is a node, a child < 0 the leaf -(child + 1).
+struct Node {
+  std::int32_t plane = 0;
+  std::int32_t children[2] = {0, 0};
+};
+
+/// The potentially visible set: bit `to` of cluster `from`'s row says
+/// whether anything in cluster `to` can be seen from anywhere in `from`.
+struct VisData {
+  std::int32_t clusters = 0;        ///< rows (and bits per row)
+  std::int32_t bytes_per_row = 0;
+  std::vector<std::uint8_t> bits;   ///< clusters * bytes_per_row
+};
+
 /// Entity: key/value pairs from the entities lump.
 using Entity = std::map<std::string, std::string>;
 
@@ -61,7 +81,27 @@ struct Map {
   std::vector<Leaf> leaves;
   std::vector<std::int32_t> leaf_faces;
   std::vector<Entity> entities;
+  std::vector<Plane> planes;
+  std::vector<Node> nodes;
+  VisData vis;  ///< empty (0 clusters) when the map was not vis-compiled
 };
+
+/// Quake 3 coordinates (Z-up, units) of an occull point (Y-up, metres) and back.
+[[nodiscard]] inline glm::vec3 to_quake(const glm::vec3& p) {
+  return glm::vec3(p.x, -p.z, p.y) * kUnitsPerMetre;
+}
+[[nodiscard]] inline glm::vec3 to_occull(const glm::vec3& p) {
+  return glm::vec3(p.x, p.z, -p.y) / kUnitsPerMetre;
+}
+
+/// The cluster of the leaf that contains `point` (Quake coordinates), found
+/// by walking the BSP tree; -1 inside solid space or outside the map.
+[[nodiscard]] std::int32_t find_cluster(const Map& map, const glm::vec3& point);
+
+/// Whether the map's PVS says cluster `to` may be visible from cluster
+/// `from`. True when either is -1 (no information) or the map has no
+/// visibility data.
+[[nodiscard]] bool cluster_sees(const Map& map, std::int32_t from, std::int32_t to);
 
 // Surface flags and contents used when converting (Quake 3's values).
 inline constexpr std::int32_t kSurfSky = 0x4;
@@ -95,12 +135,16 @@ struct LoadOptions {
 };
 
 /// Builds a scene from a map: faces grouped into culling-sized objects by
-/// spatial clustering, flat colours per texture, sky and no-draw surfaces
-/// left out, liquids and fog translucent, non-solid surfaces never
+/// spatial clustering, flat colours per texture, no-draw surfaces left
+/// out, sky surfaces opaque in a sky colour (they hide what is behind them,
+/// as in the game), liquids and fog translucent, non-solid surfaces never
 /// occluders. Paths: `tour` (spawn points, a turn in place at each, walking
 /// between them where the straight way is clear, cutting where a wall is in
 /// the way). `name` names the scene.
-[[nodiscard]] SceneBundle build_scene(const Map& map, std::string name, const LoadOptions& options = {});
+/// With `object_faces`, also returns for each object of the scene (by id)
+/// the map faces its triangles came from, ascending.
+[[nodiscard]] SceneBundle build_scene(const Map& map, std::string name, const LoadOptions& options = {},
+                                      std::vector<std::vector<std::int32_t>>* object_faces = nullptr);
 
 /// Loads "PATH.pk3:MAP" or "PATH.bsp" (the part of a scene spec after "q3:").
 [[nodiscard]] SceneBundle load(std::string_view spec, const LoadOptions& options = {});

@@ -17,12 +17,13 @@ namespace occull::q3 {
 namespace {
 
 enum Lump : int {
-  entities = 0, textures = 1, leafs = 4, leaffaces = 5, vertexes = 10, meshverts = 11, faces = 13,
-  lump_count = 17
+  entities = 0, textures = 1, planes = 2, nodes = 3, leafs = 4, leaffaces = 5, vertexes = 10, meshverts = 11,
+  faces = 13, visdata = 16, lump_count = 17
 };
 
 constexpr std::size_t kHeaderSize = 8 + lump_count * 8;
-constexpr std::size_t kTextureSize = 72, kLeafSize = 48, kVertexSize = 44, kFaceSize = 104;
+constexpr std::size_t kTextureSize = 72, kPlaneSize = 16, kNodeSize = 36, kLeafSize = 48, kVertexSize = 44,
+                      kFaceSize = 104;
 
 class Reader {
  public:
@@ -211,7 +212,66 @@ Map read_bsp(std::span<const std::byte> data, std::string_view source) {
     const auto [at, n] = r.lump(entities, 1, "entities");
     map.entities = parse_entities(r.text(at, n), r);
   }
+  {
+    const auto [at, n] = r.lump(planes, kPlaneSize, "planes");
+    map.planes.reserve(n);
+    for (std::size_t i = 0; i < n; ++i) map.planes.push_back({r.vec3(at + i * kPlaneSize), r.f32(at + i * kPlaneSize + 12)});
+  }
+  {
+    const auto [at, n] = r.lump(nodes, kNodeSize, "nodes");
+    map.nodes.reserve(n);
+    for (std::size_t i = 0; i < n; ++i) {
+      const std::size_t p = at + i * kNodeSize;
+      Node node{r.i32(p), {r.i32(p + 4), r.i32(p + 8)}};
+      if (node.plane < 0 || std::size_t(node.plane) >= map.planes.size())
+        r.fail(fmt::format("node {} uses plane {} of {}", i, node.plane, map.planes.size()));
+      for (std::int32_t child : node.children) {
+        // Children come after their parent, so the walk from node 0 always ends.
+        const bool ok = child >= 0 ? std::size_t(child) > i && std::size_t(child) < n
+                                   : std::size_t(-(std::int64_t(child) + 1)) < map.leaves.size();
+        if (!ok)
+          r.fail(fmt::format("node {} has child {} (nodes must point to later nodes or to one of the {} leaves)", i,
+                             child, map.leaves.size()));
+      }
+      map.nodes.push_back(node);
+    }
+  }
+  {
+    const auto [at, n] = r.lump(visdata, 1, "visdata");
+    if (n > 0) {
+      if (n < 8) r.fail(fmt::format("visdata of {} bytes has no header", n));
+      VisData& v = map.vis;
+      v.clusters = r.i32(at);
+      v.bytes_per_row = r.i32(at + 4);
+      if (v.clusters < 0 || v.bytes_per_row < 0 || std::int64_t(v.bytes_per_row) * 8 < v.clusters ||
+          8 + std::int64_t(v.clusters) * v.bytes_per_row > std::int64_t(n))
+        r.fail(fmt::format("visdata claims {} clusters of {} bytes in {} bytes", v.clusters, v.bytes_per_row, n));
+      v.bits.resize(std::size_t(v.clusters) * std::size_t(v.bytes_per_row));
+      for (std::size_t i = 0; i < v.bits.size(); ++i) v.bits[i] = std::to_integer<std::uint8_t>(data[at + 8 + i]);
+      for (std::size_t i = 0; i < map.leaves.size(); ++i)
+        if (map.leaves[i].cluster >= v.clusters)
+          r.fail(fmt::format("leaf {} is in cluster {} of the visdata's {}", i, map.leaves[i].cluster, v.clusters));
+    }
+  }
   return map;
+}
+
+std::int32_t find_cluster(const Map& map, const glm::vec3& point) {
+  if (map.nodes.empty()) return map.leaves.empty() ? -1 : map.leaves.front().cluster;
+  std::int32_t index = 0;
+  while (index >= 0) {  // children always point forward: at most nodes.size() steps
+    const Node& node = map.nodes[std::size_t(index)];
+    const Plane& plane = map.planes[std::size_t(node.plane)];
+    index = node.children[glm::dot(plane.normal, point) - plane.dist >= 0.0f ? 0 : 1];
+  }
+  return map.leaves[std::size_t(-(std::int64_t(index) + 1))].cluster;
+}
+
+bool cluster_sees(const Map& map, std::int32_t from, std::int32_t to) {
+  const VisData& v = map.vis;
+  if (from < 0 || to < 0 || v.clusters == 0 || from >= v.clusters || to >= v.clusters) return true;
+  const std::uint8_t byte = v.bits[std::size_t(from) * std::size_t(v.bytes_per_row) + std::size_t(to) / 8];
+  return (byte >> (to % 8)) & 1;
 }
 
 namespace {

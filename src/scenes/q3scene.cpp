@@ -19,7 +19,6 @@
 namespace occull::q3 {
 namespace {
 
-glm::vec3 to_occull(const glm::vec3& p) { return glm::vec3(p.x, p.z, -p.y) / kUnitsPerMetre; }
 glm::vec3 to_occull_direction(const glm::vec3& n) { return glm::vec3(n.x, n.z, -n.y); }
 
 using Triangle = scenes::SoupTriangle;  // material = texture index
@@ -46,9 +45,13 @@ std::vector<Triangle> triangles_of(const Map& map, int patch_level) {
   std::vector<Triangle> out;
   std::vector<Vertex> verts;
   std::vector<std::uint32_t> idx;
-  for (const Face& f : map.faces) {
+  for (std::size_t face = 0; face < map.faces.size(); ++face) {
+    const Face& f = map.faces[face];
     const Texture& t = map.textures[std::size_t(f.texture)];
-    if (t.surface_flags & (kSurfSky | kSurfNoDraw)) continue;
+    // No-draw surfaces are invisible in the game. Sky surfaces are drawn
+    // (the game paints the sky box on them) and hide what lies behind them:
+    // they are opaque here too, or geometry the game never shows would be.
+    if ((t.surface_flags & kSurfNoDraw) && !(t.surface_flags & kSurfSky)) continue;
     verts.clear();
     idx.clear();
     const std::span<const Vertex> fv(map.vertices.data() + f.first_vertex, std::size_t(f.vertex_count));
@@ -64,6 +67,7 @@ std::vector<Triangle> triangles_of(const Map& map, int patch_level) {
     for (std::size_t k = 0; k + 2 < idx.size(); k += 3) {
       Triangle tri;
       tri.material = f.texture;
+      tri.source = std::int32_t(face);
       for (int c = 0; c < 3; ++c) {
         tri.p[c] = to_occull(verts[idx[k + std::size_t(c)]].position);
         tri.n[c] = to_occull_direction(verts[idx[k + std::size_t(c)]].normal);
@@ -172,7 +176,8 @@ CameraPath tour_path(std::vector<Spawn> spawns, const std::vector<Triangle>& tri
 
 }  // namespace
 
-SceneBundle build_scene(const Map& map, std::string name, const LoadOptions& options) {
+SceneBundle build_scene(const Map& map, std::string name, const LoadOptions& options,
+                        std::vector<std::vector<std::int32_t>>* object_faces) {
   SceneBundle bundle{Scene(std::move(name)), {}, Lens{75.0f, 0.05f, 400.0f}};
   Scene& scene = bundle.scene;
   std::vector<Triangle> tris = triangles_of(map, std::clamp(options.patch_level, 1, 32));
@@ -182,8 +187,10 @@ SceneBundle build_scene(const Map& map, std::string name, const LoadOptions& opt
   for (std::size_t i = 0; i < map.textures.size(); ++i) {
     const Texture& t = map.textures[i];
     const bool translucent = (t.contents & (kContentsLiquid | kContentsFog | kContentsTranslucent)) != 0;
-    material[i] = scene.add_material({t.name, glm::vec4(texture_color(t.name), translucent ? 0.45f : 1.0f),
-                                      translucent, 0});
+    const bool sky = (t.surface_flags & kSurfSky) != 0;
+    const glm::vec3 color = sky ? glm::vec3(0.62f, 0.74f, 0.86f) : texture_color(t.name);
+    material[i] = scene.add_material({t.name, glm::vec4(color, translucent && !sky ? 0.45f : 1.0f),
+                                      translucent && !sky, 0});
   }
   const auto translucent = [&](const Triangle& t) {
     return scene.material(material[std::size_t(t.material)]).translucent;
@@ -206,6 +213,13 @@ SceneBundle build_scene(const Map& map, std::string name, const LoadOptions& opt
                               : solid                       ? OccluderClass::always
                                                             : OccluderClass::sometimes;
     scene.add_object(scene.add_mesh(std::move(mesh)), m, glm::mat4(1.0f), cls);
+    if (object_faces) {
+      std::vector<std::int32_t> faces;
+      for (std::size_t i = begin; i < end; ++i) faces.push_back(tris[i].source);
+      std::sort(faces.begin(), faces.end());
+      faces.erase(std::unique(faces.begin(), faces.end()), faces.end());
+      object_faces->push_back(std::move(faces));
+    }
   }
   // Only opaque triangles stop the camera's walk.
   tris.resize(opaque_end);

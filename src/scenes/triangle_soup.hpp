@@ -14,6 +14,7 @@ struct SoupTriangle {
   glm::vec3 p[3];
   glm::vec3 n[3];
   std::int32_t material;  ///< loader-defined material key
+  std::int32_t source = -1;  ///< loader-defined origin (a Quake 3 face), -1 when none
 };
 
 /// Splits [begin, end) recursively at the median centroid along the longest
