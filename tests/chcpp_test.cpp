@@ -40,28 +40,69 @@ std::function<std::uint64_t(std::span<const Aabb>)> visible_if_overlapping(std::
 }  // namespace
 
 TEST(Multiquery, GroupSizeMaximisesBenefitOverCost) {
-  const std::vector<std::vector<double>> cases = {
-      {0.99, 0.99, 0.98, 0.97, 0.95, 0.9, 0.8, 0.6, 0.4, 0.3},
-      {0.999, 0.999, 0.999, 0.999},
-      {0.3, 0.3, 0.29},
-      {0.9, 0.8, 0.7, 0.6, 0.5, 0.4},
-      {0.9}};
-  for (const auto& p : cases) {
-    double best = 1.0, keep = 1;  // individual queries: V = 1
-    std::size_t best_j = 1;
-    for (std::size_t j = 1; j <= p.size(); ++j) {
-      keep *= p[j - 1];
-      const double v = double(j) / (1.0 + (1.0 - keep) * double(j));
-      if (v > best) best = v, best_j = j;
-    }
-    EXPECT_EQ(best_multiquery_size(p), best_j);
-  }
+  // V(j) = j / (1 + (1 - prod_{i<=j} p_i) j), worked by hand.
+  // 0.99 0.99 0.98 0.97 0.95 0.9 ...: V(4) = 4 / (1 + 0.06832 * 4) = 3.142,
+  // V(5) = 5 / (1 + 0.114904 * 5) = 3.176, V(6) = 6 / (1 + 0.203414 * 6) = 2.702.
+  EXPECT_EQ(best_multiquery_size(std::vector<double>{0.99, 0.99, 0.98, 0.97, 0.95, 0.9, 0.8, 0.6, 0.4, 0.3}), 5u);
+  // 0.9 0.8 0.7 ...: V(1) = 0.909, V(2) = 2 / 1.56 = 1.282, V(3) = 3 / 2.488 = 1.206.
+  EXPECT_EQ(best_multiquery_size(std::vector<double>{0.9, 0.8, 0.7, 0.6, 0.5, 0.4}), 2u);
+  // 0.999 x 4: V(4) = 4 / 1.016 = 3.94, the largest.
+  EXPECT_EQ(best_multiquery_size(std::vector<double>{0.999, 0.999, 0.999, 0.999}), 4u);
+  // 0.3 0.3 0.29: every V(j) < 1 (V(1) = 0.588): each node alone.
+  EXPECT_EQ(best_multiquery_size(std::vector<double>{0.3, 0.3, 0.29}), 1u);
+  EXPECT_EQ(best_multiquery_size(std::vector<double>{0.9}), 1u);
   // Nodes certain to stay invisible go in one query.
   EXPECT_EQ(best_multiquery_size(std::vector<double>(30, 1.0)), 30u);
   // Likely ones first, the group stops where the unlikely ones begin.
   std::vector<double> mixed(5, 0.99);
   mixed.insert(mixed.end(), 20, 0.3);
   EXPECT_EQ(best_multiquery_size(mixed), 5u);
+}
+
+TEST(Chcpp, NodesThatStayInvisibleShareMultiqueriesAndAFailedOneIsSplit) {
+  // 40 boxes in view, visible in a checkerboard pattern for 20 frames, so
+  // the hidden leaves form the invisible boundary one by one (hidden ones
+  // side by side would make a hidden subtree: one query for all of them);
+  // their persistence grows and CHC++ tests them together. Then one odd box
+  // appears: its multiquery comes back visible, the nodes are re-queried one
+  // by one, and the object is drawn in that same frame.
+  std::vector<Aabb> boxes;
+  for (int i = 0; i < 40; ++i) {
+    const float x = float(i % 8) * 3.0f - 12.0f, y = float(i / 8) * 3.0f - 7.0f;
+    boxes.push_back({{x, y, -40}, {x + 1, y + 1, -39}});
+  }
+  const Scene scene = test::box_scene(boxes);
+  BvhOptions bo;
+  bo.max_leaf_objects = 1;
+  const Bvh bvh = Bvh::build(scene, bo);
+  Options o;
+  o.set("chcpp.tight", "off");  // one box per node: boxes per query = nodes per query
+  o.set("chcpp.virtual_leaf", "0");
+  o.set("chcpp.pkeep_samples", "5");
+  auto culler = make_culler("chcpp", {scene, bvh}, o);
+  const auto hidden = [](ObjectId i) { return (i % 8 + i / 8) % 2 == 1; };
+  std::vector<Aabb> visible;
+  for (ObjectId i = 0; i < boxes.size(); ++i)
+    if (!hidden(i)) visible.push_back(boxes[i]);
+  test::RecordingBackend backend;
+  backend.visible_samples = visible_if_overlapping(&visible);
+  const View view = make_view({{0, 0, 0}, 0, 0}, {90.0f, 0.1f, 500.0f}, 64, 64);
+  std::uint64_t multiqueries = 0;
+  for (int f = 0; f < 20; ++f) multiqueries += culler->render_frame(view, backend).multiqueries;
+  EXPECT_GT(multiqueries, 0u) << "persistently invisible nodes are grouped";
+  std::size_t largest = 0;
+  for (const auto& q : backend.queried) largest = std::max(largest, q.size());
+  EXPECT_GE(largest, 10u) << "groups of many nodes";
+  for (ObjectId id : backend.rendered) EXPECT_FALSE(hidden(id)) << "hidden object " << id << " drawn";
+
+  ASSERT_TRUE(hidden(17));
+  visible.push_back(boxes[17]);
+  backend.rendered.clear();
+  const FrameStats s = culler->render_frame(view, backend);
+  EXPECT_GE(s.failed_multiqueries, 1u);
+  const std::set<ObjectId> drawn(backend.rendered.begin(), backend.rendered.end());
+  EXPECT_TRUE(drawn.count(17)) << "drawn in the frame it appears";
+  for (ObjectId id : drawn) EXPECT_TRUE(!hidden(id) || id == 17) << "hidden object " << id << " drawn";
 }
 
 TEST(Multiquery, NoGroupWhenIndividualQueriesAreExpectedToBeCheaper) {

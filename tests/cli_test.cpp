@@ -50,17 +50,38 @@ enum Column { kMean = 1, kMedian, kP95, kMax, kVsVfc, kVsOracle, kQueries, kStat
 
 }  // namespace
 
-TEST(Cli, HelpOnEveryCommandExitsZero) {
-  for (const char* cmd : {"", "info", "scenes", "algos", "bench", "render"}) {
-    const CliRun r = run(std::string(cmd) + " --help");
+TEST(Cli, HelpOnEveryCommandNamesItsOptions) {
+  const std::vector<std::pair<std::string, std::vector<std::string>>> commands = {
+      {"", {"bench", "calibrate", "render", "scenes", "algos", "info", "path", "Exit codes"}},
+      {"info", {"--help"}},
+      {"scenes", {"--list-maps"}},
+      {"algos", {"--help"}},
+      {"path", {"--scene", "--path", "--out"}},
+      {"bench", {"--scene", "--path", "--algo", "--frames", "--fps", "--start", "--size", "--query-mode",
+                 "--query-raster", "--query-margin", "--draw", "--verify", "--repeat", "--model", "--json"}},
+      {"calibrate", {"--size", "--repeats", "--out", "--check"}},
+      {"render", {"--scene", "--frame", "--fps", "--out"}}};
+  for (const auto& [cmd, options] : commands) {
+    const CliRun r = run(cmd + " --help");
     EXPECT_EQ(r.code, 0) << cmd << ": " << r.output;
-    EXPECT_NE(r.output.find("--help"), std::string::npos) << cmd;
+    for (const std::string& o : options) EXPECT_NE(r.output.find(o), std::string::npos) << cmd << " help lacks " << o;
   }
 }
 
-TEST(Cli, NoCommandIsAUsageError) { EXPECT_EQ(run("").code, 2); }
+TEST(Cli, NoCommandIsAUsageErrorThatSaysSo) {
+  const CliRun r = run("");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.output.find("subcommand"), std::string::npos) << r.output;
+}
 
-TEST(Cli, UnknownCommandIsAUsageError) { EXPECT_EQ(run("frobnicate").code, 2); }
+TEST(Cli, UnknownCommandIsAUsageErrorThatNamesIt) {
+  const CliRun r = run("frobnicate");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.output.find("unknown command 'frobnicate'; valid commands: info, scenes, path, algos, bench, "
+                          "calibrate, render"),
+            std::string::npos)
+      << r.output;
+}
 
 TEST(Cli, UnknownSceneListsValidScenes) {
   const CliRun r = run("bench --scene town --frames 1");
@@ -89,9 +110,15 @@ TEST(Cli, InvalidSizeIsRejected) {
 }
 
 TEST(Cli, InvalidFrameCountIsRejected) {
-  EXPECT_EQ(run(std::string("bench ") + kTinyCity + " --frames 0").code, 2);
-  EXPECT_EQ(run(std::string("bench ") + kTinyCity + " --frames many").code, 2);
-  EXPECT_EQ(run(std::string("render ") + kTinyCity + " --frame 7 --frames 5 --out /dev/null").code, 2);
+  CliRun r = run(std::string("bench ") + kTinyCity + " --frames 0");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.output.find("--frames 0: must be at least 1"), std::string::npos) << r.output;
+  r = run(std::string("bench ") + kTinyCity + " --frames many");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.output.find("--frames"), std::string::npos) << r.output;
+  r = run(std::string("render ") + kTinyCity + " --frame 7 --frames 5 --out /dev/null");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.output.find("--frame 7 is outside [0, 4]"), std::string::npos) << r.output;
 }
 
 TEST(Cli, UnknownOptionListsValidOptions) {
@@ -123,11 +150,13 @@ TEST(Cli, BenchPrintsATableRowPerAlgorithm) {
     EXPECT_NE(r.output.find(col), std::string::npos) << col;
 }
 
-TEST(Cli, RenderWritesAPng) {
+TEST(Cli, RenderWritesAPngAndSaysWhatItDrew) {
   const std::string out = ::testing::TempDir() + "occull_cli_render.png";
   std::remove(out.c_str());
   const CliRun r = run(std::string("render ") + kTinyCity + " --frame 2 --frames 5 --out " + out);
   ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("wrote " + out + " (64x48)"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("frame 2 with vfc"), std::string::npos) << r.output;
   std::ifstream f(out, std::ios::binary);
   char magic[8] = {};
   f.read(magic, 8);
@@ -172,8 +201,12 @@ TEST(Cli, OracleWithoutVerificationIsAUsageError) {
 }
 
 TEST(Cli, InvalidRepeatAndVerifyValuesAreRejected) {
-  EXPECT_EQ(run(std::string("bench ") + kTinyCity + " --repeat 0 --no-report").code, 2);
-  EXPECT_EQ(run(std::string("bench ") + kTinyCity + " --verify maybe --no-report").code, 2);
+  CliRun r = run(std::string("bench ") + kTinyCity + " --repeat 0 --no-report");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.output.find("--repeat 0: must be at least 1"), std::string::npos) << r.output;
+  r = run(std::string("bench ") + kTinyCity + " --verify maybe --no-report");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.output.find("--verify 'maybe': expected on or off"), std::string::npos) << r.output;
 }
 
 TEST(Cli, UnwritableReportFolderIsAClearError) {
@@ -191,6 +224,81 @@ TEST(Cli, CalibrateWritesAProfileThatNohcLoads) {
     EXPECT_NE(cal.output.find(q), std::string::npos) << q;
   const CliRun bench = run(std::string("bench ") + kTinyCity + " --algo nohc --frames 2 --warmup 0 --no-report --opt nohc.profile=" + profile);
   EXPECT_EQ(bench.code, 0) << bench.output;
+  EXPECT_FALSE(table_row(bench.output, "nohc").empty()) << bench.output;
+  EXPECT_EQ(bench.output.find("calibrating"), std::string::npos) << "the given profile is used";
+}
+
+TEST(Cli, CalibrateCheckReportsVerdictsAndWritesNothing) {
+  const std::string cache = ::testing::TempDir() + "occull_check_cache";
+  std::filesystem::remove_all(cache);
+  const CliRun r = run("calibrate --check --size 96x54 --repeats 1", "XDG_CACHE_HOME=" + cache);
+  ASSERT_EQ(r.code, 0) << r.output;
+  for (const char* s : {"first run:", "second run:", "a triangle costs less than a draw call", "repeats within a factor of 2",
+                        "checks suspect"})
+    EXPECT_NE(r.output.find(s), std::string::npos) << s << "\n" << r.output;
+  EXPECT_FALSE(std::filesystem::exists(cache + "/occull")) << "--check writes no profile";
+}
+
+TEST(Cli, ModelPrintsPredictedAgainstMeasuredForEveryAlgorithm) {
+  const CliRun r = run(std::string("bench ") + kTinyCity + " --algo vfc,chcpp --frames 3 --warmup 0 --model --no-report --opt nohc.profile=" +
+                       OCCULL_TEST_PROFILE);
+  ASSERT_EQ(r.code, 0) << r.output;
+  const auto at = r.output.find("cost model (NOHC");
+  ASSERT_NE(at, std::string::npos) << r.output;
+  const std::string model = r.output.substr(at);
+  EXPECT_NE(model.find("predicted"), std::string::npos);
+  for (const char* algo : {"vfc", "chcpp"}) {
+    const auto row = table_row(model, algo);
+    ASSERT_EQ(row.size(), 4u) << algo << "\n" << model;  // name, measured, predicted, error
+    EXPECT_GT(std::stod(row[2]), 0.0) << "a frame that draws is predicted to cost time";
+  }
+}
+
+TEST(Cli, EveryQueryModeRunsVerifiedWithoutMisses) {
+  for (const char* mode : {"samples", "any", "conservative"}) {
+    const CliRun r = run(std::string("bench ") + kTinyCity + " --algo chc,chcpp --frames 4 --warmup 0 --no-report --query-mode " + mode);
+    ASSERT_EQ(r.code, 0) << mode << "\n" << r.output;
+    EXPECT_NE(r.output.find("verification passed"), std::string::npos) << mode << "\n" << r.output;
+    for (const char* algo : {"chc", "chcpp"}) {
+      const auto row = table_row(r.output, algo);
+      ASSERT_GT(row.size(), std::size_t(kMissed)) << r.output;
+      EXPECT_GT(std::stod(row[kQueries]), 0.0) << mode << " " << algo;
+    }
+  }
+  EXPECT_EQ(run(std::string("bench ") + kTinyCity + " --query-mode some --no-report").code, 2);
+}
+
+TEST(Cli, MultiDrawSubmitsTheSameObjectsAsSingleDraws) {
+  std::vector<std::string> rows[2];
+  int i = 0;
+  for (const char* draw : {"single", "multi"}) {
+    const CliRun r = run(std::string("bench ") + kTinyCity + " --algo vfc,oracle --frames 4 --warmup 0 --no-report --draw " + draw);
+    ASSERT_EQ(r.code, 0) << draw << "\n" << r.output;
+    rows[i++] = table_row(r.output, "vfc");
+  }
+  ASSERT_GT(rows[0].size(), std::size_t(kTriangles));
+  ASSERT_GT(rows[1].size(), std::size_t(kTriangles));
+  EXPECT_EQ(rows[0][kDraws], rows[1][kDraws]);
+  EXPECT_EQ(rows[0][kTriangles], rows[1][kTriangles]);
+  const CliRun bad = run(std::string("bench ") + kTinyCity + " --draw batched --no-report");
+  EXPECT_EQ(bad.code, 2);
+  EXPECT_NE(bad.output.find("valid modes: single, multi"), std::string::npos) << bad.output;
+}
+
+TEST(Cli, QueryGeometryIsReportedAndSelectable) {
+  const CliRun info = run("info");
+  EXPECT_NE(info.output.find("query boxes are kept conservative by: outline widened by 0.125 px"), std::string::npos)
+      << info.output;
+  const CliRun exact = run(std::string("bench ") + kTinyCity + " --algo vfc --frames 2 --warmup 0 --no-report --query-raster exact");
+  ASSERT_EQ(exact.code, 0) << exact.output;
+  EXPECT_NE(exact.output.find("query boxes: exact boxes"), std::string::npos) << exact.output;
+  const CliRun hardware = run(std::string("bench ") + kTinyCity + " --algo vfc --frames 2 --warmup 0 --no-report --query-raster hardware");
+  ASSERT_EQ(hardware.code, 0) << hardware.output;
+  EXPECT_NE(hardware.output.find("query boxes: "), std::string::npos) << hardware.output;
+  const CliRun bad = run(std::string("bench ") + kTinyCity + " --query-raster fuzzy --no-report");
+  EXPECT_EQ(bad.code, 2);
+  EXPECT_NE(bad.output.find("valid values: margin, hardware, exact"), std::string::npos) << bad.output;
+  EXPECT_EQ(run(std::string("bench ") + kTinyCity + " --query-margin -1 --no-report").code, 2);
 }
 
 TEST(Cli, CorruptProfileIsAClearError) {
@@ -245,6 +353,9 @@ TEST(Cli, ModelFilesLoadThroughAssimp) {
   const CliRun r = run("bench --scene file:" + obj + " --algo vfc,chcpp,oracle --frames 4 --warmup 0 --size 96x54 --no-report");
   EXPECT_EQ(r.code, 0) << r.output;
   EXPECT_NE(r.output.find("12 triangles"), std::string::npos) << r.output;
+  const auto oracle = table_row(r.output, "oracle");
+  ASSERT_GT(oracle.size(), std::size_t(kTriangles)) << r.output;
+  EXPECT_EQ(oracle[kTriangles], "12") << "the cube is in view and drawn";
 }
 
 // The newcomer's first run: no hardware profile cached, so nohc calibrates

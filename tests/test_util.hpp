@@ -65,11 +65,13 @@ inline Scene glass_scene() {
 }
 
 /// Backend double: records what was rendered and queried; a query's
-/// result comes from `visible_samples(boxes)` (default: 1 sample per box).
+/// result comes from `visible_samples(boxes)` (default: 1 sample per box)
+/// and is available when `available(query)` says so (default: at once).
 class RecordingBackend final : public Backend {
  public:
   std::function<std::uint64_t(std::span<const Aabb>)> visible_samples =
       [](std::span<const Aabb> b) { return std::uint64_t(b.size()); };
+  std::function<bool(QueryId)> available = [](QueryId) { return true; };
   std::vector<ObjectId> rendered;
   std::vector<std::vector<Aabb>> queried;
 
@@ -84,7 +86,7 @@ class RecordingBackend final : public Backend {
     ++stats_.queries;
     return QueryId(results_.size() - 1);
   }
-  bool result_available(QueryId) override { return true; }
+  bool result_available(QueryId q) override { return available(q); }
   std::uint64_t result(QueryId q) override { return results_.at(q); }
   [[nodiscard]] BackendStats stats() const override { return stats_; }
 

@@ -483,6 +483,20 @@ int main(int argc, char** argv) {
   r->add_option("--out", render.out, "output PNG file")->capture_default_str();
   r->add_option("--opt", render.opts, "algorithm option algo.key=value (repeatable)");
 
+  // An unknown command: name it and list the valid ones (CLI11 would only
+  // say that a subcommand is required).
+  if (argc > 1 && argv[1][0] != '-') {
+    std::string valid;
+    bool known = false;
+    for (const CLI::App* sub : app.get_subcommands([](CLI::App*) { return true; })) {
+      known = known || sub->get_name() == argv[1];
+      valid += (valid.empty() ? "" : ", ") + sub->get_name();
+    }
+    if (!known) {
+      std::cerr << "occull: unknown command '" << argv[1] << "'; valid commands: " << valid << "\n";
+      return kExitInput;
+    }
+  }
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -166,7 +166,7 @@ void write_json(const BenchResult& r, std::ostream& out) {
   doc["truth_probes"] = r.truth_probes;
   doc["truth_pixels"] = r.truth_pixels;
   doc["modelled"] = r.modelled;
-  if (!r.profile_path.empty()) doc["hardware_profile"] = r.profile_path;
+  doc["hardware_profile"] = r.profile_path.empty() ? ordered_json() : ordered_json(r.profile_path);
   doc["size"] = {r.width, r.height};
   doc["query_geometry"] = r.query_geometry;
   ordered_json algos = ordered_json::array();

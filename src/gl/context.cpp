@@ -110,7 +110,12 @@ Context::~Context() {
   if (display_) {
     eglMakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
     if (context_) eglDestroyContext(display_, context_);
-    eglTerminate(display_);
+    // No eglTerminate: the display is shared by every context of the process
+    // (eglGetPlatformDisplay returns the same one), and terminating it makes
+    // Mesa unload its driver. llvmpipe reloaded into a process whose LLVM
+    // stays loaded runs its LLVM set-up again, and one occull bench in about
+    // fifty then died of heap corruption. Initialising an initialised
+    // display is a no-op, so the next Context reuses the loaded driver.
   }
 }
 

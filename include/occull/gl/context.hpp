@@ -23,8 +23,10 @@ struct DeviceInfo {
   std::vector<std::string> culling_extensions;
 };
 
-/// Owns an EGL display and an OpenGL 4.5 core context, current on the
-/// creating thread for the object's lifetime. Not copyable; one per thread.
+/// Owns an OpenGL 4.5 core context on the process's headless EGL display,
+/// current on the creating thread for the object's lifetime. Not copyable;
+/// one per thread. The display stays initialised after the last Context is
+/// gone (see ~Context): the driver is loaded once per process.
 class Context {
  public:
   /// Creates the context: Mesa's surfaceless platform first, the EGL device
