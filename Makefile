@@ -1,17 +1,24 @@
 # occull — the two commands:
 #   make demo   install dependencies, build (Release), run the main benchmark
 #   make test   install dependencies, build, run every test (ctest)
+#   make test-asan   the same tests built with AddressSanitizer, LeakSanitizer and UBSan
 BUILD ?= build
 JOBS ?= $(shell nproc)
 CMAKE_FLAGS ?=
 
-.PHONY: demo test deps data configure build install clean
+.PHONY: demo test test-asan deps data configure build install clean
 
 demo: build
 	./$(BUILD)/occull bench
 
 test: build data
 	cd $(BUILD) && ctest --output-on-failure -j $(JOBS)
+
+# Every test again with AddressSanitizer, LeakSanitizer and UBSan (build-asan/).
+test-asan: deps data
+	cmake -S . -B $(BUILD)-asan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DOCCULL_SANITIZE=ON $(CMAKE_FLAGS)
+	cmake --build $(BUILD)-asan -j $(JOBS)
+	cd $(BUILD)-asan && ctest --output-on-failure -j $(JOBS)
 
 deps:
 	./scripts/install-deps.sh
@@ -32,4 +39,4 @@ install: build
 	cmake --install $(BUILD) --prefix $(PREFIX)
 
 clean:
-	rm -rf $(BUILD)
+	rm -rf $(BUILD) $(BUILD)-asan
