@@ -7,7 +7,6 @@
 #include "oracle.hpp"
 
 #include <fmt/format.h>
-#include <glm/gtc/constants.hpp>
 
 #include <algorithm>
 #include <chrono>
@@ -34,6 +33,21 @@ SceneBundle timed_make_scene(std::string_view spec, double& ms) {
 }
 
 double median_of(std::vector<double> v) { return summarize(std::move(v)).median; }
+
+// How far the camera moves and turns between consecutive frames of a run.
+void measure_camera_motion(const Session& session, const CameraPath& path, int frames, BenchResult& r) {
+  for (int k = 1; k < frames; ++k) {
+    const View a = session.view_at(path, k - 1, frames), b = session.view_at(path, k, frames);
+    const double step = glm::length(b.eye - a.eye);
+    // Forward is -Z of the view: the third row of the view matrix, negated.
+    const glm::vec3 fa(-a.view[0][2], -a.view[1][2], -a.view[2][2]), fb(-b.view[0][2], -b.view[1][2], -b.view[2][2]);
+    const double turn = glm::degrees(std::acos(std::clamp(double(glm::dot(fa, fb)), -1.0, 1.0)));
+    r.step_m_mean += step / double(frames - 1);
+    r.turn_deg_mean += turn / double(frames - 1);
+    r.step_m_max = std::max(r.step_m_max, step);
+    r.turn_deg_max = std::max(r.turn_deg_max, turn);
+  }
+}
 
 }  // namespace
 
@@ -463,17 +477,7 @@ BenchResult run_bench(const BenchConfig& config, const ProgressFn& progress) {
   result.frames = config.frames;
   result.sampling = config.sampling;
   result.path_duration_s = path.duration();
-  for (int k = 1; k < config.frames; ++k) {
-    const View a = session.view_at(path, k - 1, config.frames), b = session.view_at(path, k, config.frames);
-    const double step = glm::length(b.eye - a.eye);
-    // Forward is -Z of the view: the third row of the view matrix, negated.
-    const glm::vec3 fa(-a.view[0][2], -a.view[1][2], -a.view[2][2]), fb(-b.view[0][2], -b.view[1][2], -b.view[2][2]);
-    const double turn = glm::degrees(std::acos(std::clamp(double(glm::dot(fa, fb)), -1.0, 1.0)));
-    result.step_m_mean += step / double(config.frames - 1);
-    result.turn_deg_mean += turn / double(config.frames - 1);
-    result.step_m_max = std::max(result.step_m_max, step);
-    result.turn_deg_max = std::max(result.turn_deg_max, turn);
-  }
+  measure_camera_motion(session, path, config.frames, result);
   result.warmup = config.warmup;
   result.repeat = config.repeat;
   result.verified = config.verify;

@@ -108,6 +108,7 @@ std::unique_ptr<Context> Context::create() {
 
 Context::~Context() {
   if (display_) {
+    if (eglGetCurrentContext() == context_) glFinish();  // no work in flight when the context goes
     eglMakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
     if (context_) eglDestroyContext(display_, context_);
     // No eglTerminate: the display is shared by every context of the process

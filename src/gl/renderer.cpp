@@ -602,6 +602,7 @@ Renderer::Renderer(const Scene& scene, const RendererOptions& options)
 
 Renderer::~Renderer() {
   Impl& g = *impl_;
+  glFinish();  // nothing of ours may still be in flight when its objects go
   if (!g.query_names.empty())
     glDeleteQueries(GLsizei(g.query_names.size()), g.query_names.data());
   if (g.timer) glDeleteQueries(1, &g.timer);
