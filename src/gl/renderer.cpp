@@ -112,10 +112,14 @@ uniform vec3 u_eye;
 uniform vec2 u_half_viewport;  // pixels
 uniform float u_margin;        // pixels
 
+// Component i of v, without indexing (llvmpipe turns a dynamic index into
+// memory addressing; selects are plain arithmetic).
+float pick(vec3 v, int i) { return i == 0 ? v.x : (i == 1 ? v.y : v.z); }
+
 // The face on `axis` at its max (hi) or min side faces the eye and has area.
 bool facing(int axis, bool hi, vec3 extent) {
-  bool faces = hi ? u_eye[axis] > a_max[axis] : u_eye[axis] < a_min[axis];
-  return faces && extent[(axis + 1) % 3] > 0.0 && extent[(axis + 2) % 3] > 0.0;
+  bool faces = hi ? pick(u_eye, axis) > pick(a_max, axis) : pick(u_eye, axis) < pick(a_min, axis);
+  return faces && pick(extent, (axis + 1) % 3) > 0.0 && pick(extent, (axis + 2) % 3) > 0.0;
 }
 
 void main() {
@@ -130,7 +134,7 @@ void main() {
   int f = (e + 1) % 3, g = (e + 2) % 3;                   // its two faces' axes
   vec3 extent = a_max - a_min;
   const float min_w = 1e-5;
-  bool silhouette = facing(f, a_p[f] > 0.5, extent) != facing(g, a_p[g] > 0.5, extent);
+  bool silhouette = facing(f, pick(a_p, f) > 0.5, extent) != facing(g, pick(a_p, g) > 0.5, extent);
   if (u_margin <= 0.0 || !silhouette || max(a.w, b.w) <= min_w) {
     gl_Position = at_b ? b : a;  // a band of zero area
     return;
