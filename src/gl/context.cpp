@@ -108,8 +108,12 @@ std::unique_ptr<Context> Context::create() {
 
 Context::~Context() {
   if (display_) {
-    if (eglGetCurrentContext() == context_) glFinish();  // no work in flight when the context goes
-    eglMakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
+    // Release only our own context: eglMakeCurrent(EGL_NO_CONTEXT) unbinds
+    // whatever is current on this thread, which may be another Context's.
+    if (eglGetCurrentContext() == context_) {
+      glFinish();  // no work in flight when the context goes
+      eglMakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
+    }
     if (context_) eglDestroyContext(display_, context_);
     // No eglTerminate: the display is shared by every context of the process
     // (eglGetPlatformDisplay returns the same one), and terminating it makes
