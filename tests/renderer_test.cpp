@@ -433,13 +433,3 @@ TEST_F(RendererTest, ZeroThicknessBoxIsWidenedAlongItsWholeOutline) {
   EXPECT_GE(n, 68u);  // as QueryOutlineWidensByTheMarginSideways
   EXPECT_LE(n, 80u);
 }
-
-// A context that goes must not take the current one with it: releasing is
-// per thread, not per context, so ~Context releases only its own.
-TEST(Context, DestroyingAnIdleContextLeavesTheCurrentOneCurrent) {
-  auto idle = gl::Context::create();
-  auto current = gl::Context::create();  // the newest context is current
-  ASSERT_FALSE(current->info().renderer.empty());
-  idle.reset();
-  EXPECT_FALSE(current->info().renderer.empty());
-}

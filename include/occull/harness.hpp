@@ -112,11 +112,7 @@ class Session {
   /// algorithm's run cannot leave driver state that slows the next (seen on
   /// llvmpipe: after `perobject`'s thousands of small flushes per frame,
   /// chc/chcpp in the same context ran 10-20% slower for the rest of the
-  /// process). Costs a fraction of a second. The replaced context is kept,
-  /// idle, until the session ends: destroying a context right after its
-  /// last frame crashed Mesa 22.3's llvmpipe about once in 100 benches
-  /// (heap corruption in the next context's first draws; see
-  /// docs/performance.md), and one kept context removed it.
+  /// process). Costs a fraction of a second.
   void reset_renderer();
 
   /// Runs one frame: moves dynamic objects to `time_s` (untimed), then
@@ -196,7 +192,6 @@ class Session {
   SceneBundle bundle_;
   Bvh bvh_;
   std::unique_ptr<gl::Context> context_;
-  std::vector<std::unique_ptr<gl::Context>> retired_contexts_;  // idle until ~Session
   gl::DeviceInfo device_;
   gl::RendererOptions renderer_options_;
   std::unique_ptr<gl::Renderer> renderer_;

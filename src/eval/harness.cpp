@@ -90,7 +90,7 @@ Session::Session(std::string_view scene_spec, const gl::RendererOptions& rendere
 
 void Session::reset_renderer() {
   renderer_.reset();
-  retired_contexts_.push_back(std::move(context_));
+  context_.reset();
   context_ = gl::Context::create();
   renderer_ = std::make_unique<gl::Renderer>(bundle_.scene, renderer_options_);
 }
@@ -98,7 +98,6 @@ void Session::reset_renderer() {
 Session::~Session() {
   renderer_.reset();  // GL objects go before the context
   context_.reset();
-  retired_contexts_.clear();
 }
 
 const CameraPath& Session::path(std::string_view name) {

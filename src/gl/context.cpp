@@ -107,23 +107,17 @@ std::unique_ptr<Context> Context::create() {
 }
 
 Context::~Context() {
-  if (!display_ || !context_) return;
-  // A context is destroyed while it is current, as the driver expects of a
-  // context that has drawn; a context that was current before comes back
-  // after (releasing is per thread, so releasing ours would leave none).
-  EGLContext previous = eglGetCurrentContext();
-  if (previous != context_) eglMakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, context_);
-  glFinish();  // no work in flight when the context goes
-  eglMakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
-  eglDestroyContext(display_, context_);
-  if (previous != EGL_NO_CONTEXT && previous != context_)
-    eglMakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, previous);
-  // No eglTerminate: the display is shared by every context of the process
-  // (eglGetPlatformDisplay returns the same one), and terminating it makes
-  // Mesa unload its driver. llvmpipe reloaded into a process whose LLVM
-  // stays loaded runs its LLVM set-up again, and one occull bench in about
-  // fifty then died of heap corruption. Initialising an initialised
-  // display is a no-op, so the next Context reuses the loaded driver.
+  if (display_) {
+    if (eglGetCurrentContext() == context_) glFinish();  // no work in flight when the context goes
+    eglMakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
+    if (context_) eglDestroyContext(display_, context_);
+    // No eglTerminate: the display is shared by every context of the process
+    // (eglGetPlatformDisplay returns the same one), and terminating it makes
+    // Mesa unload its driver. llvmpipe reloaded into a process whose LLVM
+    // stays loaded runs its LLVM set-up again, and one occull bench in about
+    // fifty then died of heap corruption. Initialising an initialised
+    // display is a no-op, so the next Context reuses the loaded driver.
+  }
 }
 
 DeviceInfo Context::info() const {
