@@ -408,3 +408,18 @@ TEST(Cli, FramesPastTheEndOfThePathAreRejected) {
   EXPECT_EQ(run(std::string("bench ") + kTinyCity + " --algo vfc --fps -3 --no-report").code, 2);
   EXPECT_EQ(run(std::string("render ") + kTinyCity + " --fps 60 --start 1000 --out /dev/null").code, 2);
 }
+
+TEST(Cli, BenchNamesTheAllocatorPolicyAndSaysWhereTheTimeGoes) {
+  const CliRun r = run(std::string("bench ") + kTinyCity + " --frames 2 --warmup 0 --algo vfc,chcpp --no-report");
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("allocator: engine"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("where the time goes"), std::string::npos) << r.output;
+  for (const char* column : {"cpu ms", "us/node", "faults", "sys ms"})
+    EXPECT_NE(r.output.find(column), std::string::npos) << column;
+  const CliRun system = run(std::string("bench ") + kTinyCity + " --frames 1 --warmup 0 --algo vfc --no-report --malloc system");
+  ASSERT_EQ(system.code, 0) << system.output;
+  EXPECT_NE(system.output.find("allocator: system"), std::string::npos) << system.output;
+  const CliRun bad = run(std::string("bench ") + kTinyCity + " --frames 1 --algo vfc --no-report --malloc tcmalloc");
+  EXPECT_EQ(bad.code, 2) << bad.output;
+  EXPECT_NE(bad.output.find("engine, system"), std::string::npos) << bad.output;
+}

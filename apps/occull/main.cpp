@@ -11,6 +11,7 @@
 #include "occull/gl/calibrate.hpp"
 #include "occull/gl/context.hpp"
 #include "occull/gl/renderer.hpp"
+#include "occull/process.hpp"
 #include "occull/profile_io.hpp"
 #include "occull/q3bsp.hpp"
 #include "occull/harness.hpp"
@@ -35,6 +36,10 @@ constexpr int kExitInternal = 1;
 constexpr int kExitInput = 2;
 constexpr int kExitNoGl = 3;
 constexpr int kExitVerificationFailed = 4;
+
+constexpr const char* kMallocHelp =
+    "allocator policy of the process: engine (keep freed heap memory, as engines do, so driver batches do "
+    "not page-fault it back in) or system (glibc's defaults)";
 
 struct Size {
   int width = 1280;
@@ -206,6 +211,7 @@ struct BenchArgs {
   std::string report = "occull-report";
   bool no_report = false;
   bool model = false;
+  std::string malloc_policy = "engine";
 };
 
 bool parse_on_off(const std::string& flag, const std::string& s) {
@@ -241,6 +247,7 @@ void check_written(const std::ofstream& f, const std::string& path) {
 
 int cmd_bench(const BenchArgs& a) {
   occull::BenchConfig c;
+  c.allocator = occull::apply_allocator_policy(occull::parse_allocator_policy(a.malloc_policy));
   c.scene = a.scene;
   c.path = a.path;
   c.algorithms = split_list(a.algos);
@@ -292,6 +299,7 @@ struct CalibrateArgs {
   int repeats = 5;
   std::string out;
   bool check = false;
+  std::string malloc_policy = "engine";
 };
 
 std::string time_text(double ms) {
@@ -308,6 +316,8 @@ int cmd_calibrate(const CalibrateArgs& a) {
   const Size size = parse_size(a.size);
   if (a.repeats < 1 || a.repeats > 100)
     throw occull::InputError(fmt::format("--repeats {}: must be in [1, 100]", a.repeats));
+  const std::string allocator = occull::apply_allocator_policy(occull::parse_allocator_policy(a.malloc_policy));
+  std::fprintf(stderr, "allocator: %s\n", allocator.c_str());
   const auto context = occull::gl::Context::create();
   const auto device = context->info();
   const std::string key = device.renderer + " | " + device.version;
@@ -460,8 +470,10 @@ int main(int argc, char** argv) {
       ->capture_default_str();
 
   CalibrateArgs calibrate;
+  b->add_option("--malloc", bench.malloc_policy, kMallocHelp)->capture_default_str();
   auto* cal = app.add_subcommand("calibrate",
                                  "measure the NOHC hardware cost model on this renderer and cache it");
+  cal->add_option("--malloc", calibrate.malloc_policy, kMallocHelp)->capture_default_str();
   cal->add_option("--size", calibrate.size, "render size WIDTHxHEIGHT")->capture_default_str();
   cal->add_option("--repeats", calibrate.repeats, "rounds per measurement (median kept)")->capture_default_str();
   cal->add_option("--out", calibrate.out, "write the profile here instead of the per-user cache");

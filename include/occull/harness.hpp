@@ -218,6 +218,7 @@ struct BenchConfig {
   bool multi_draw = false;                ///< see gl::RendererOptions::multi_draw
   BvhOptions bvh;                         ///< how the scene's hierarchy is built
   bool model = false;                     ///< also predict each frame with the NOHC cost model
+  std::string allocator;                  ///< the process's allocator policy, as the report names it (apply_allocator_policy)
   FaultHooks hooks;                       ///< tests only: break a step on purpose (see FaultHooks)
 };
 
@@ -253,6 +254,10 @@ struct AlgorithmSummary {
   double cpu_ms_per_frame = 0.0;
   double gpu_ms_per_frame = 0.0;
   double model_ms_per_frame = 0.0;        ///< cost-model prediction (0 without --model)
+  double cpu_us_per_node = 0.0;           ///< culler CPU time per visited node, microseconds (0: no nodes)
+  double kernel_ms_per_frame = 0.0;       ///< process CPU time in the kernel (FrameStats::kernel_ms)
+  double minor_faults_per_frame = 0.0;    ///< process page faults (FrameStats::minor_faults)
+  double major_faults_per_frame = 0.0;
   std::uint64_t missed_objects = 0;       ///< sum over frames of objects missed
   std::uint64_t frames_with_misses = 0;
   std::uint64_t wrong_pixels = 0;         ///< sum over frames
@@ -286,6 +291,7 @@ struct BenchResult {
   int width = 0;
   int height = 0;
   std::string query_geometry;                ///< how query boxes were kept conservative (describe_query_raster)
+  std::string allocator;                     ///< BenchConfig::allocator ("" when not given)
   std::vector<AlgorithmRun> runs;            ///< in execution order
   std::vector<AlgorithmSummary> summaries;   ///< one per algorithm, in the order asked
 };

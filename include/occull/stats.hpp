@@ -15,6 +15,12 @@ struct FrameStats {
   double wait_ms = 0.0;   ///< time blocked on query results
   double gpu_ms = 0.0;    ///< GPU time from timer queries (0 when unavailable)
   double model_ms = 0.0;  ///< the NOHC cost model's prediction of this frame (occull bench --model)
+  double kernel_ms = 0.0; ///< CPU time the whole process spent in the kernel during the frame
+
+  // What the operating system did during the frame (whole process, driver
+  // threads included): page faults are allocator churn, not algorithm cost.
+  std::uint64_t minor_faults = 0;
+  std::uint64_t major_faults = 0;
 
   // Culler counters.
   std::uint64_t nodes_visited = 0;        ///< hierarchy nodes the traversal touched

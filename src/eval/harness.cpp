@@ -3,6 +3,7 @@
 #include "occull/error.hpp"
 #include "occull/gl/calibrate.hpp"
 #include "invariants.hpp"
+#include "occull/process.hpp"
 #include "occull/profile_io.hpp"
 #include "oracle.hpp"
 
@@ -119,6 +120,7 @@ View Session::view_at(const CameraPath& path, int k, int frames) const {
 
 FrameStats Session::run_frame(Culler& culler, const View& view, double time_s) {
   bundle_.scene.update(time_s);
+  const ProcessUsage u0 = process_usage();
   const auto t0 = Clock::now();
   bvh_.refit(bundle_.scene);
   renderer_->begin_frame(view);
@@ -129,7 +131,11 @@ FrameStats Session::run_frame(Culler& culler, const View& view, double time_s) {
   const BackendStats during = renderer_->stats() - before;
   s.gpu_ms = renderer_->end_frame();
   const auto t1 = Clock::now();
+  const ProcessUsage u1 = process_usage();
   const BackendStats d = renderer_->stats() - before;
+  s.minor_faults = u1.minor_faults - u0.minor_faults;
+  s.major_faults = u1.major_faults - u0.major_faults;
+  s.kernel_ms = u1.kernel_ms - u0.kernel_ms;
   s.frame_ms = ms_between(t0, t1);
   s.cpu_ms = std::max(0.0, ms_between(c0, c1) - during.backend_ms);
   s.wait_ms = d.wait_ms;
@@ -349,6 +355,9 @@ std::vector<AlgorithmSummary> summarize_runs(std::span<const AlgorithmRun> runs)
         sums["cpu_ms"] += f.cpu_ms;
         sums["gpu_ms"] += f.gpu_ms;
         sums["model_ms"] += f.model_ms;
+        sums["kernel_ms"] += f.kernel_ms;
+        sums["minor_faults"] += double(f.minor_faults);
+        sums["major_faults"] += double(f.major_faults);
         missed += f.missed_objects;
         frames_missing += f.missed_objects > 0 ? 1 : 0;
         wrong += f.wrong_pixels;
@@ -360,6 +369,7 @@ std::vector<AlgorithmSummary> summarize_runs(std::span<const AlgorithmRun> runs)
       per_repeat["p95"].push_back(s.p95);
       per_repeat["max"].push_back(s.max);
       for (const auto& [key, sum] : sums) per_repeat[key].push_back(sum / n);
+      if (sums["nodes_visited"] > 0) per_repeat["cpu_us_per_node"].push_back(1e3 * sums["cpu_ms"] / sums["nodes_visited"]);
       const auto ratio = [&](const char* base, const char* key) {
         const auto it = mean_ms.find({r.repeat, base});
         if (it != mean_ms.end() && it->second > 0) per_repeat[key].push_back(s.mean / it->second);
@@ -395,6 +405,10 @@ std::vector<AlgorithmSummary> summarize_runs(std::span<const AlgorithmRun> runs)
     a.cpu_ms_per_frame = med("cpu_ms");
     a.gpu_ms_per_frame = med("gpu_ms");
     a.model_ms_per_frame = med("model_ms");
+    a.cpu_us_per_node = med("cpu_us_per_node");
+    a.kernel_ms_per_frame = med("kernel_ms");
+    a.minor_faults_per_frame = med("minor_faults");
+    a.major_faults_per_frame = med("major_faults");
     out.push_back(std::move(a));
   }
   return out;
@@ -486,6 +500,7 @@ BenchResult run_bench(const BenchConfig& config, const ProgressFn& progress) {
   result.width = config.width;
   result.height = config.height;
   result.query_geometry = gl::describe_query_raster(ropts);
+  result.allocator = config.allocator;
 
   std::vector<FrameTruth> truth;
   if (config.verify) truth = session.ground_truth(path, config.frames, progress);

@@ -107,8 +107,10 @@ std::string misses_text(const BenchResult& r, std::uint64_t v) {
 
 void print_table(const BenchResult& r, std::ostream& out) {
   out << setup_line(r) << "\n";
-  out << fmt::format("device: {} | {} | occull {}\nquery boxes: {}\n\n", r.device.renderer, r.device.version,
+  out << fmt::format("device: {} | {} | occull {}\nquery boxes: {}\n", r.device.renderer, r.device.version,
                      r.commit, r.query_geometry);
+  if (!r.allocator.empty()) out << fmt::format("allocator: {}\n", r.allocator);
+  out << "\n";
   std::size_t w = 10;
   for (const AlgorithmSummary& a : r.summaries) w = std::max(w, a.name.size());
   out << fmt::format("{:<{}} {:>8} {:>8} {:>8} {:>8} {:>6} {:>7} {:>8} {:>7} {:>7} {:>10} {:>7} {:>9}\n",
@@ -125,6 +127,14 @@ void print_table(const BenchResult& r, std::ostream& out) {
   }
   if (r.verified) out << "\n";
   for (const std::string& line : verdict_lines(r)) out << line << "\n";
+  out << fmt::format("\nwhere the time goes (per frame)\n{:<{}} {:>7} {:>8} {:>8} {:>8} {:>7} {:>8} {:>8} {:>7}\n",
+                     "algorithm", w, "cpu ms", "us/node", "nodes", "wait ms", "waits", "gpu ms", "faults",
+                     "sys ms");
+  for (const AlgorithmSummary& a : r.summaries)
+    out << fmt::format("{:<{}} {:>7.3f} {:>8.3f} {:>8.0f} {:>8.3f} {:>7.1f} {:>8.2f} {:>8.0f} {:>7.2f}\n", a.name, w,
+                       a.cpu_ms_per_frame, a.cpu_us_per_node, a.nodes_visited_per_frame, a.wait_ms_per_frame,
+                       a.blocking_waits_per_frame, a.gpu_ms_per_frame,
+                       a.minor_faults_per_frame + a.major_faults_per_frame, a.kernel_ms_per_frame);
   if (r.modelled) {
     out << fmt::format("\ncost model (NOHC, profile {}): mean frame ms\n", r.profile_path);
     out << fmt::format("{:<{}} {:>9} {:>10} {:>8}\n", "algorithm", w, "measured", "predicted", "error");
@@ -138,7 +148,11 @@ void print_table(const BenchResult& r, std::ostream& out) {
       << (r.repeat > 1 ? ", median over repeats" : "")
       << "; vs vfc / vs orcl: mean frame time over vfc's / oracle's in the same run.\n"
          "queries, states (render<->query switches), draws, triangles: per frame. missed: objects "
-         "visible in the ground truth but not rendered, summed over frames; wrong px: their pixels.\n";
+         "visible in the ground truth but not rendered, summed over frames; wrong px: their pixels.\n"
+         "cpu ms: the culler's own CPU time (outside backend calls); us/node: that per visited hierarchy node; "
+         "wait ms / waits: time and reads blocked on query results; gpu ms: timer queries; faults, sys ms: page "
+         "faults and kernel CPU time of the whole process (driver threads too), allocator churn rather than "
+         "culling cost.\n";
 }
 
 void write_json(const BenchResult& r, std::ostream& out) {
@@ -169,6 +183,7 @@ void write_json(const BenchResult& r, std::ostream& out) {
   doc["hardware_profile"] = r.profile_path.empty() ? ordered_json() : ordered_json(r.profile_path);
   doc["size"] = {r.width, r.height};
   doc["query_geometry"] = r.query_geometry;
+  doc["allocator"] = r.allocator;
   ordered_json algos = ordered_json::array();
   for (const AlgorithmSummary& a : r.summaries) {
     algos.push_back({{"name", a.name},
@@ -201,6 +216,10 @@ void write_json(const BenchResult& r, std::ostream& out) {
                      {"blocking_waits_per_frame", a.blocking_waits_per_frame},
                      {"cpu_ms_per_frame", a.cpu_ms_per_frame},
                      {"gpu_ms_per_frame", a.gpu_ms_per_frame},
+                     {"cpu_us_per_node", a.cpu_us_per_node},
+                     {"kernel_ms_per_frame", a.kernel_ms_per_frame},
+                     {"minor_faults_per_frame", a.minor_faults_per_frame},
+                     {"major_faults_per_frame", a.major_faults_per_frame},
                      {"model_ms_per_frame", r.modelled ? ordered_json(a.model_ms_per_frame) : ordered_json()}});
   }
   doc["algorithms"] = algos;
@@ -211,7 +230,7 @@ void write_csv(const BenchResult& r, std::ostream& out) {
   out << "algorithm,repeat,frame,frame_ms,cpu_ms,wait_ms,gpu_ms,queries,query_boxes,multiqueries,"
          "failed_multiqueries,query_batches,state_changes,material_changes,render_flushes,"
          "draw_calls,triangles,objects_rendered,nodes_visited,truth_objects,missed_objects,"
-         "wrong_pixels,extra_objects,blocking_waits,model_ms\n";
+         "wrong_pixels,extra_objects,blocking_waits,model_ms,kernel_ms,minor_faults,major_faults\n";
   for (const AlgorithmRun& run : r.runs) {
     for (std::size_t k = 0; k < run.frames.size(); ++k) {
       const FrameStats& f = run.frames[k];
@@ -220,7 +239,8 @@ void write_csv(const BenchResult& r, std::ostream& out) {
                          f.query_boxes, f.multiqueries, f.failed_multiqueries, f.query_batches,
                          f.state_changes, f.material_changes, f.render_flushes, f.draw_calls,
                          f.triangles, f.objects_rendered, f.nodes_visited, f.truth_objects,
-                         f.missed_objects, f.wrong_pixels, f.extra_objects, f.blocking_waits, f.model_ms);
+                         f.missed_objects, f.wrong_pixels, f.extra_objects, f.blocking_waits, f.model_ms,
+                         f.kernel_ms, f.minor_faults, f.major_faults);
     }
   }
 }
@@ -276,20 +296,22 @@ std::vector<std::string> write_report(const BenchResult& r, const std::string& d
   md += fmt::format("- repeats: {} (algorithms interleaved; figures are medians over repeats)\n", r.repeat);
   md += fmt::format("- {}\n", verification_text(r));
   md += fmt::format("- query boxes: {}\n", r.query_geometry);
+  if (!r.allocator.empty()) md += fmt::format("- allocator: {}\n", r.allocator);
   md += fmt::format("- occull commit: `{}`\n\n## Results\n\n", r.commit);
   md += "| algorithm | mean ms | median | p95 | max | vs vfc | vs oracle | queries | state changes | "
         "draws | triangles | missed | frames w/ miss | wrong px | longest miss | extra objects | "
-        "wait ms | cpu ms |\n";
-  md += "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
+        "wait ms | cpu ms | cpu us/node | page faults | sys ms |\n";
+  md += "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
   for (const AlgorithmSummary& a : r.summaries) {
     md += fmt::format("| {} | {:.2f} | {:.2f} | {:.2f} | {:.2f} | {} | {} | {:.1f} | {:.1f} | {:.0f} | {:.0f} | "
-                      "{} | {} | {} | {} | {:.1f} | {:.3f} | {:.3f} |\n",
+                      "{} | {} | {} | {} | {:.1f} | {:.3f} | {:.3f} | {:.3f} | {:.0f} | {:.2f} |\n",
                       a.name, a.frame_ms.mean, a.frame_ms.median, a.frame_ms.p95, a.frame_ms.max,
                       ratio_text(a.ratio_to_vfc), ratio_text(a.ratio_to_oracle), a.queries_per_frame,
                       a.state_changes_per_frame, a.draw_calls_per_frame, a.triangles_per_frame,
                       misses_text(r, a.missed_objects), misses_text(r, a.frames_with_misses),
                       misses_text(r, a.wrong_pixels), misses_text(r, a.longest_miss_frames),
-                      a.extra_objects_per_frame, a.wait_ms_per_frame, a.cpu_ms_per_frame);
+                      a.extra_objects_per_frame, a.wait_ms_per_frame, a.cpu_ms_per_frame, a.cpu_us_per_node,
+                      a.minor_faults_per_frame + a.major_faults_per_frame, a.kernel_ms_per_frame);
   }
   md += "\n";
   for (const std::string& line : verdict_lines(r)) md += "**" + line + "**\n\n";
