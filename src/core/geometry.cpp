@@ -2,7 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
-#include <vector>
+#include <array>
 
 namespace occull {
 
@@ -90,42 +90,52 @@ double polygon_area(std::span<const glm::dvec2> pts) noexcept {
 
 namespace {
 
-double cross(const glm::dvec2& o, const glm::dvec2& a, const glm::dvec2& b) {
+// At most 8 corners plus 12 near-plane crossings; each of the four screen
+// edges adds at most one vertex to a convex polygon.
+constexpr std::size_t kMaxPoints = 24;
+struct Polygon {
+  std::array<glm::dvec2, kMaxPoints> p;
+  std::size_t n = 0;
+  void push(const glm::dvec2& v) noexcept {
+    if (n < kMaxPoints) p[n++] = v;
+  }
+};
+
+double cross(const glm::dvec2& o, const glm::dvec2& a, const glm::dvec2& b) noexcept {
   return (a.x - o.x) * (b.y - o.y) - (a.y - o.y) * (b.x - o.x);
 }
 
-// Andrew's monotone chain; returns the hull counter-clockwise.
-std::vector<glm::dvec2> convex_hull(std::vector<glm::dvec2> pts) {
-  std::sort(pts.begin(), pts.end(),
+// Andrew's monotone chain, in place of `pts`; the hull counter-clockwise.
+Polygon convex_hull(Polygon pts) noexcept {
+  std::sort(pts.p.begin(), pts.p.begin() + std::ptrdiff_t(pts.n),
             [](const glm::dvec2& a, const glm::dvec2& b) { return a.x < b.x || (a.x == b.x && a.y < b.y); });
-  if (pts.size() < 3) return pts;
-  std::vector<glm::dvec2> hull(2 * pts.size());
+  if (pts.n < 3) return pts;
+  std::array<glm::dvec2, 2 * kMaxPoints> hull;
   std::size_t k = 0;
-  for (const auto& p : pts) {
-    while (k >= 2 && cross(hull[k - 2], hull[k - 1], p) <= 0) --k;
-    hull[k++] = p;
+  for (std::size_t i = 0; i < pts.n; ++i) {
+    while (k >= 2 && cross(hull[k - 2], hull[k - 1], pts.p[i]) <= 0) --k;
+    hull[k++] = pts.p[i];
   }
-  for (std::size_t i = pts.size() - 1, lower = k + 1; i-- > 0;) {
-    while (k >= lower && cross(hull[k - 2], hull[k - 1], pts[i]) <= 0) --k;
-    hull[k++] = pts[i];
+  for (std::size_t i = pts.n - 1, lower = k + 1; i-- > 0;) {
+    while (k >= lower && cross(hull[k - 2], hull[k - 1], pts.p[i]) <= 0) --k;
+    hull[k++] = pts.p[i];
   }
-  hull.resize(k - 1);
-  return hull;
+  Polygon out;
+  for (std::size_t i = 0; i + 1 < k; ++i) out.push(hull[i]);
+  return out;
 }
 
 // Sutherland–Hodgman against one axis-aligned half-plane: keeps points whose
 // coordinate `axis` is >= bound (sign = +1) or <= bound (sign = -1).
-std::vector<glm::dvec2> clip_half_plane(const std::vector<glm::dvec2>& poly, int axis,
-                                        double bound, double sign) {
-  std::vector<glm::dvec2> out;
-  const std::size_t n = poly.size();
-  for (std::size_t i = 0; i < n; ++i) {
-    const glm::dvec2& a = poly[i];
-    const glm::dvec2& b = poly[(i + 1) % n];
+Polygon clip_half_plane(const Polygon& poly, int axis, double bound, double sign) noexcept {
+  Polygon out;
+  for (std::size_t i = 0; i < poly.n; ++i) {
+    const glm::dvec2& a = poly.p[i];
+    const glm::dvec2& b = poly.p[(i + 1) % poly.n];
     const double da = sign * (a[axis] - bound);
     const double db = sign * (b[axis] - bound);
-    if (da >= 0) out.push_back(a);
-    if ((da >= 0) != (db >= 0)) out.push_back(a + (b - a) * (da / (da - db)));
+    if (da >= 0) out.push(a);
+    if ((da >= 0) != (db >= 0)) out.push(a + (b - a) * (da / (da - db)));
   }
   return out;
 }
@@ -141,31 +151,43 @@ double projected_area(const Aabb& b, const glm::mat4& view_proj, int width, int 
   // Distance to the near plane in clip space is z + w (OpenGL conventions).
   const auto near_dist = [](const glm::dvec4& c) { return c.z + c.w; };
 
-  std::vector<glm::dvec2> pts;
-  pts.reserve(20);
+  Polygon pts;
   const auto add = [&](const glm::dvec4& c) {
     const glm::dvec2 ndc(c.x / c.w, c.y / c.w);
-    pts.emplace_back((ndc.x * 0.5 + 0.5) * width, (ndc.y * 0.5 + 0.5) * height);
+    pts.push({(ndc.x * 0.5 + 0.5) * width, (ndc.y * 0.5 + 0.5) * height});
   };
-  for (const auto& c : clip)
-    if (near_dist(c) >= 0 && c.w > 0) add(c);
-  for (const auto& e : edges) {
-    const glm::dvec4& a = clip[e[0]];
-    const glm::dvec4& c = clip[e[1]];
-    const double da = near_dist(a), dc = near_dist(c);
-    if ((da >= 0) != (dc >= 0)) {
-      const glm::dvec4 p = a + (c - a) * (da / (da - dc));
-      if (p.w > 0) add(p);
+  bool crosses_near = false;
+  for (const auto& c : clip) {
+    if (near_dist(c) >= 0 && c.w > 0)
+      add(c);
+    else
+      crosses_near = true;
+  }
+  if (crosses_near) {
+    for (const auto& e : edges) {
+      const glm::dvec4& a = clip[e[0]];
+      const glm::dvec4& c = clip[e[1]];
+      const double da = near_dist(a), dc = near_dist(c);
+      if ((da >= 0) != (dc >= 0)) {
+        const glm::dvec4 p = a + (c - a) * (da / (da - dc));
+        if (p.w > 0) add(p);
+      }
     }
   }
-  if (pts.size() < 3) return 0.0;
-  std::vector<glm::dvec2> poly = convex_hull(std::move(pts));
-  poly = clip_half_plane(poly, 0, 0.0, 1.0);
-  poly = clip_half_plane(poly, 0, double(width), -1.0);
-  poly = clip_half_plane(poly, 1, 0.0, 1.0);
-  poly = clip_half_plane(poly, 1, double(height), -1.0);
-  if (poly.size() < 3) return 0.0;
-  return polygon_area(poly);
+  if (pts.n < 3) return 0.0;
+  Polygon poly = convex_hull(pts);
+  // Clip to the screen only at the sides the outline crosses.
+  glm::dvec2 lo = poly.p[0], hi = poly.p[0];
+  for (std::size_t i = 1; i < poly.n; ++i) {
+    lo = glm::min(lo, poly.p[i]);
+    hi = glm::max(hi, poly.p[i]);
+  }
+  if (lo.x < 0.0) poly = clip_half_plane(poly, 0, 0.0, 1.0);
+  if (hi.x > double(width)) poly = clip_half_plane(poly, 0, double(width), -1.0);
+  if (lo.y < 0.0) poly = clip_half_plane(poly, 1, 0.0, 1.0);
+  if (hi.y > double(height)) poly = clip_half_plane(poly, 1, double(height), -1.0);
+  if (poly.n < 3) return 0.0;
+  return polygon_area(std::span<const glm::dvec2>(poly.p.data(), poly.n));
 }
 
 }  // namespace occull

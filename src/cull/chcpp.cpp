@@ -113,6 +113,8 @@ class ChcppCuller final : public Culler {
     ++frame_;
     if (state_.size() != index_.bvh.size()) state_.assign(index_.bvh.size(), NodeState{});
     f_.begin(view, backend);
+    frustum_.begin(index_.bvh, view);
+    query_nodes_.clear();
 
     distance_queue_.push(index_.bvh, Bvh::root(), view.eye);
     while (!distance_queue_.empty() || !query_queue_.empty() || !i_queue_.empty()) {
@@ -136,7 +138,7 @@ class ChcppCuller final : public Culler {
       while (!v_queue_.empty()) {
         const NodeId n = v_queue_.front();
         v_queue_.pop_front();
-        issue({n}, true);
+        issue_one(n, true);
       }
     }
     flush_render_queue();
@@ -147,7 +149,8 @@ class ChcppCuller final : public Culler {
  private:
   struct Pending {
     QueryId id;
-    std::vector<NodeId> nodes;  // > 1: a multiquery
+    std::uint32_t first;  // its nodes: query_nodes_[first, first + count); count > 1: a multiquery
+    std::uint32_t count;
     bool previously_visible;
   };
   struct Invisible {
@@ -165,8 +168,7 @@ class ChcppCuller final : public Culler {
     s.last_visited = frame_;
     if (previously_visible) s.invisible_tests = 0;  // if invisible now, its persistence starts over
     const BvhNode& node = index_.bvh.node(n);
-    if (node.object_count == 0 || f_.view->frustum.classify(node.bounds) == Containment::outside)
-      return;
+    if (node.object_count == 0 || frustum_.outside(index_.bvh, n)) return;
     if (near_eye(node.bounds, *f_.view, f_.near_radius)) {
       pull_up_visibility(state_, index_.bvh, n);
       traverse(n);
@@ -184,7 +186,7 @@ class ChcppCuller final : public Culler {
         } else {
           flush_render_queue();  // CHC order: query the leaf, then render it
           ++f_.stats.query_batches;
-          issue({n}, true);
+          issue_one(n, true);
         }
       } else {
         pull_up_visibility(state_, index_.bvh, n);
@@ -195,7 +197,7 @@ class ChcppCuller final : public Culler {
 
   void traverse(NodeId n) {
     if (is_leaf(n)) {
-      append_objects_in_frustum(index_, n, *f_.view, render_queue_);
+      append_objects_in_frustum(index_, n, *f_.view, render_queue_, frustum_.planes(n));
       render_queue_triangles_ += index_.bvh.node(n).triangles;
       if (config_.render_batch_triangles > 0 && render_queue_triangles_ >= config_.render_batch_triangles) {
         flush_render_queue();
@@ -214,11 +216,20 @@ class ChcppCuller final : public Culler {
     render_queue_triangles_ = 0;
   }
 
-  void issue(std::vector<NodeId> nodes, bool previously_visible) {
+  // One query over the nodes query_nodes_[first, end()).
+  void issue(std::uint32_t first, bool previously_visible) {
+    const auto count = std::uint32_t(query_nodes_.size() - first);
     boxes_.clear();
-    for (NodeId n : nodes) append_query_boxes(index_, n, config_.shape, boxes_);
-    if (nodes.size() > 1) ++f_.stats.multiqueries;
-    query_queue_.push_back({f_.backend->issue_query(boxes_), std::move(nodes), previously_visible});
+    for (std::uint32_t i = first; i < first + count; ++i)
+      append_query_boxes(index_, query_nodes_[i], config_.shape, boxes_);
+    if (count > 1) ++f_.stats.multiqueries;
+    query_queue_.push_back({f_.backend->issue_query(boxes_), first, count, previously_visible});
+  }
+
+  void issue_one(NodeId n, bool previously_visible) {
+    const auto first = std::uint32_t(query_nodes_.size());
+    query_nodes_.push_back(n);
+    issue(first, previously_visible);
   }
 
   void issue_v_query() {
@@ -226,7 +237,7 @@ class ChcppCuller final : public Culler {
     ++f_.stats.query_batches;
     const NodeId n = v_queue_.front();
     v_queue_.pop_front();
-    issue({n}, true);
+    issue_one(n, true);
   }
 
   // Issues the i-queue as one batch: multiqueries grouped by p_keep, or
@@ -235,40 +246,37 @@ class ChcppCuller final : public Culler {
     if (i_queue_.empty()) return;
     flush_render_queue();
     ++f_.stats.query_batches;
-    std::vector<Invisible> grouped;
+    // Most likely to stay invisible first.
+    order_.clear();
     for (const Invisible& e : i_queue_) {
       if (e.single || !config_.multiquery)
-        issue({e.node}, false);
+        issue_one(e.node, false);
       else
-        grouped.push_back(e);
+        order_.emplace_back(persistence_.p_keep(state_[e.node].invisible_tests), e.node);
     }
     i_queue_.clear();
-    if (grouped.empty()) return;
-    // Most likely to stay invisible first.
-    std::vector<std::pair<double, NodeId>> order;
-    order.reserve(grouped.size());
-    for (const Invisible& e : grouped)
-      order.emplace_back(persistence_.p_keep(state_[e.node].invisible_tests), e.node);
-    std::stable_sort(order.begin(), order.end(),
+    if (order_.empty()) return;
+    std::stable_sort(order_.begin(), order_.end(),
                      [](const auto& a, const auto& b) { return a.first > b.first; });
-    std::vector<double> p(order.size());
-    for (std::size_t i = 0; i < order.size(); ++i) p[i] = order[i].first;
-    for (std::size_t begin = 0; begin < order.size();) {
-      const std::size_t size = best_multiquery_size(std::span<const double>(p).subspan(begin));
-      std::vector<NodeId> nodes;
-      for (std::size_t i = begin; i < begin + size; ++i) nodes.push_back(order[i].second);
-      issue(std::move(nodes), false);
+    p_keep_.resize(order_.size());
+    for (std::size_t i = 0; i < order_.size(); ++i) p_keep_[i] = order_[i].first;
+    for (std::size_t begin = 0; begin < order_.size();) {
+      const std::size_t size = best_multiquery_size(std::span<const double>(p_keep_).subspan(begin));
+      const auto first = std::uint32_t(query_nodes_.size());
+      for (std::size_t i = begin; i < begin + size; ++i) query_nodes_.push_back(order_[i].second);
+      issue(first, false);
       begin += size;
     }
     if (config_.flush_batches) f_.backend->flush();
   }
 
   void handle_returned_query() {
-    Pending q = std::move(query_queue_.front());
+    const Pending q = query_queue_.front();
     query_queue_.pop_front();
     const bool visible = f_.backend->result(q.id) > config_.common.threshold;
+    const std::span<const NodeId> nodes(query_nodes_.data() + q.first, q.count);
     if (q.previously_visible) {  // a v-queue query: classification for the next frame
-      const NodeId n = q.nodes.front();
+      const NodeId n = nodes.front();
       if (visible) {
         pull_up_visibility(state_, index_.bvh, n);
         state_[n].next_query = frame_ + config_.n_av;
@@ -277,12 +285,12 @@ class ChcppCuller final : public Culler {
       }
       return;
     }
-    if (visible && q.nodes.size() > 1) {  // failed multiquery: query each node alone
+    if (visible && nodes.size() > 1) {  // failed multiquery: query each node alone
       ++f_.stats.failed_multiqueries;
-      for (NodeId n : q.nodes) i_queue_.push_back({n, true});
+      for (NodeId n : nodes) i_queue_.push_back({n, true});
       return;
     }
-    for (NodeId n : q.nodes) {
+    for (NodeId n : nodes) {
       NodeState& s = state_[n];
       persistence_.record(s.invisible_tests, !visible);
       if (!visible) {
@@ -307,6 +315,7 @@ class ChcppCuller final : public Culler {
 
   // Per frame.
   FrameContext f_;
+  FrustumCache frustum_;
   DistanceQueue distance_queue_;
   std::deque<Pending> query_queue_;
   std::vector<Invisible> i_queue_;
@@ -314,6 +323,9 @@ class ChcppCuller final : public Culler {
   std::vector<ObjectId> render_queue_;
   std::uint64_t render_queue_triangles_ = 0;
   std::vector<Aabb> boxes_;
+  std::vector<NodeId> query_nodes_;  // the nodes of this frame's queries (Pending::first, count)
+  std::vector<std::pair<double, NodeId>> order_;  // multiquery grouping scratch
+  std::vector<double> p_keep_;
 };
 
 }  // namespace

@@ -93,6 +93,7 @@ class NohcCuller final : public Culler {
     ++frame_;
     if (nodes_.size() != index_.bvh.size()) nodes_.assign(index_.bvh.size(), NodeInfo{});
     f_.begin(view, backend);
+    frustum_.begin(index_.bvh, view);
     fov_y_ = 2.0 * std::atan(1.0 / double(view.proj[1][1]));
     c_scr_ = 0.0;
 
@@ -140,10 +141,28 @@ class NohcCuller final : public Culler {
     return i.state;
   }
 
+  // Whether an occluded answer of an ancestor cancelled `n`. A node waiting
+  // in the distance queue has a parent visited this frame, and cancel()
+  // marks every visited node below the occluded one, so looking at `n` and
+  // its parent is enough (no walk to the root per popped node).
   bool cancelled(NodeId n) const {
-    for (NodeId a = n; a != kNoNode; a = index_.bvh.node(a).parent)
-      if (nodes_[a].cancelled == frame_) return true;
-    return false;
+    if (nodes_[n].cancelled == frame_) return true;
+    const NodeId parent = index_.bvh.node(n).parent;
+    return parent != kNoNode && nodes_[parent].cancelled == frame_;
+  }
+
+  // Marks `n` and its descendants visited this frame as cancelled.
+  void cancel(NodeId n) {
+    cancel_stack_.clear();
+    cancel_stack_.push_back(n);
+    while (!cancel_stack_.empty()) {
+      const NodeId m = cancel_stack_.back();
+      cancel_stack_.pop_back();
+      nodes_[m].cancelled = frame_;
+      if (index_.bvh.is_leaf(m)) continue;
+      for (NodeId c : {Bvh::left(m), index_.bvh.right(m)})
+        if (nodes_[c].last_visited == frame_ && nodes_[c].cancelled != frame_) cancel_stack_.push_back(c);
+    }
   }
 
   double c_bb(NodeId n) {
@@ -188,7 +207,7 @@ class NohcCuller final : public Culler {
     info.last_visited = frame_;
     info.state = PreviousState::outside;
     const BvhNode& node = index_.bvh.node(n);
-    if (node.object_count == 0 || f_.view->frustum.classify(node.bounds) == Containment::outside) return;
+    if (node.object_count == 0 || frustum_.outside(index_.bvh, n)) return;
     info.state = PreviousState::visible;  // until a query says otherwise
     if (near_eye(node.bounds, *f_.view, f_.near_radius)) {
       process(n);
@@ -224,16 +243,14 @@ class NohcCuller final : public Culler {
   // A child outside the frustum costs nothing to query (the granularity rule
   // then prefers querying the children).
   NodeEstimate child_estimate(NodeId c) {
-    if (index_.bvh.node(c).object_count == 0 ||
-        f_.view->frustum.classify(index_.bvh.node(c).bounds) == Containment::outside)
-      return {0.0, 0.0, 0.0, 0};
+    if (index_.bvh.node(c).object_count == 0 || frustum_.outside(index_.bvh, c)) return {0.0, 0.0, 0.0, 0};
     return estimate(c);
   }
 
   void process(NodeId n) {
     if (is_leaf(n)) {
       const std::size_t before = render_queue_.size();
-      append_objects_in_frustum(index_, n, *f_.view, render_queue_);
+      append_objects_in_frustum(index_, n, *f_.view, render_queue_, frustum_.planes(n));
       if (render_queue_.size() > before) {
         NodeCost cost;
         cost.c_bb = c_bb(n);
@@ -271,7 +288,7 @@ class NohcCuller final : public Culler {
     } else {
       info.state = PreviousState::occluded;
       info.visible = false;
-      if (!q.wait) info.cancelled = frame_;  // drop the children queued meanwhile
+      if (!q.wait) cancel(q.node);  // drop the children queued meanwhile
     }
   }
 
@@ -291,12 +308,14 @@ class NohcCuller final : public Culler {
 
   // Per frame.
   FrameContext f_;
+  FrustumCache frustum_;
   double fov_y_ = 1.0;
   double c_scr_ = 0.0;
   DistanceQueue distance_queue_;
   std::deque<Pending> query_queue_;
   std::vector<ObjectId> render_queue_;
   std::vector<Aabb> boxes_;
+  std::vector<NodeId> cancel_stack_;
 };
 
 }  // namespace

@@ -5,9 +5,12 @@
 namespace occull::detail {
 
 void append_objects_in_frustum(const SceneIndex& index, NodeId n, const View& view,
-                               std::vector<ObjectId>& out) {
-  for (ObjectId id : index.bvh.objects(n))
-    if (view.frustum.classify(index.scene.object(id).bounds) != Containment::outside) out.push_back(id);
+                               std::vector<ObjectId>& out, std::uint32_t planes) {
+  for (ObjectId id : index.bvh.objects(n)) {
+    std::uint32_t mask = planes;
+    if (mask == 0 || view.frustum.classify(index.scene.object(id).bounds, mask) != Containment::outside)
+      out.push_back(id);
+  }
 }
 
 namespace {

@@ -86,6 +86,44 @@ class DistanceQueue {
   std::priority_queue<Entry, std::vector<Entry>, std::greater<>> heap_;
 };
 
+/// Per-node frustum tests of one view, made once per frame: a node's test
+/// skips the planes its parent lies fully inside (front-to-back traversals
+/// classify a parent before its children; any order stays correct).
+class FrustumCache {
+ public:
+  /// Forgets the previous frame's tests (call at the start of each frame).
+  void begin(const Bvh& bvh, const View& view) {
+    if (nodes_.size() != bvh.size()) nodes_.assign(bvh.size(), Entry{});
+    ++frame_;
+    view_ = &view;
+  }
+  /// Whether node `n`'s box lies outside the frustum.
+  bool outside(const Bvh& bvh, NodeId n) {
+    Entry& e = nodes_[n];
+    if (e.frame != frame_) {
+      const NodeId parent = bvh.node(n).parent;
+      std::uint32_t mask =
+          parent != kNoNode && nodes_[parent].frame == frame_ ? nodes_[parent].planes : Frustum::all_planes;
+      e.outside = mask != 0 && view_->frustum.classify(bvh.node(n).bounds, mask) == Containment::outside;
+      e.planes = std::uint8_t(mask);
+      e.frame = frame_;
+    }
+    return e.outside;
+  }
+  /// The planes node `n` is not fully inside. Precondition: outside(n) was asked this frame.
+  [[nodiscard]] std::uint32_t planes(NodeId n) const { return nodes_[n].planes; }
+
+ private:
+  struct Entry {
+    std::uint32_t frame = kNever;
+    std::uint8_t planes = 0;
+    bool outside = false;
+  };
+  std::vector<Entry> nodes_;
+  std::uint32_t frame_ = 0;
+  const View* view_ = nullptr;
+};
+
 /// The eye-inside rule (DESIGN, seed 002): a box that, grown by the near
 /// plane radius, contains the eye is visible without a query — its query
 /// could miss the faces around the camera, and an object that close is
@@ -101,8 +139,10 @@ void collect_in_frustum_front_to_back(const SceneIndex& index, const View& view,
                                       std::vector<ObjectId>& out, FrameStats& stats);
 
 /// Appends the objects of node `n` whose boxes are not outside the frustum.
+/// `planes`: the frustum planes `n` is not known to lie fully inside (a
+/// Frustum plane mask); objects are tested against those only.
 void append_objects_in_frustum(const SceneIndex& index, NodeId n, const View& view,
-                               std::vector<ObjectId>& out);
+                               std::vector<ObjectId>& out, std::uint32_t planes = Frustum::all_planes);
 
 /// How a node's occlusion query is shaped.
 struct QueryShape {
