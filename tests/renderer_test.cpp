@@ -214,18 +214,22 @@ TEST_F(RendererTest, DynamicObjectsAreDrawnWhereTheyAreNow) {
   scene.add_dynamic_object(scene.add_mesh(test::box_mesh({{-1, -1, -1}, {1, 1, 1}})), grey, m,
                            OccluderClass::never);
   const View view = make_view({{0, 0, 0}, 0, 0}, {60.0f, 0.1f, 100.0f}, kSize, kSize);
-  gl::Renderer r(scene, small());
-  const ObjectId obj[] = {0};
-  scene.update(0.0);  // far left: outside the view
-  r.begin_frame(view);
-  r.render(obj);
-  r.end_frame();
-  EXPECT_TRUE(ids_in(r.read_ids()).empty());
-  scene.update(30.0);  // straight ahead
-  r.begin_frame(view);
-  r.render(obj);
-  r.end_frame();
-  EXPECT_EQ(ids_in(r.read_ids()), std::set<ObjectId>{0});
+  for (const bool multi : {false, true}) {  // matrices as uniforms, and from the object buffer
+    gl::RendererOptions o = small();
+    o.multi_draw = multi;
+    gl::Renderer r(scene, o);
+    const ObjectId obj[] = {0};
+    scene.update(0.0);  // far left: outside the view
+    r.begin_frame(view);
+    r.render(obj);
+    r.end_frame();
+    EXPECT_TRUE(ids_in(r.read_ids()).empty()) << "multi " << multi;
+    scene.update(30.0);  // straight ahead
+    r.begin_frame(view);
+    r.render(obj);
+    r.end_frame();
+    EXPECT_EQ(ids_in(r.read_ids()), std::set<ObjectId>{0}) << "multi " << multi;
+  }
 }
 
 TEST_F(RendererTest, QueryNamesAreReusedAfterResults) {
@@ -262,6 +266,8 @@ TEST_F(RendererTest, MultiDrawGivesTheSamePixelsAsSingleDraws) {
                                  {{-9, -2, -30}, {-5, 2, -25}}});
   const View view = make_view({{0, 0, 0}, 0, 0}, {60.0f, 0.1f, 100.0f}, kSize, kSize);
   std::vector<std::uint32_t> images[2];
+  std::vector<std::uint8_t> colours[2];
+  std::vector<float> depths[2];
   for (int multi = 0; multi < 2; ++multi) {
     gl::RendererOptions o = small();
     o.multi_draw = multi == 1;
@@ -273,9 +279,15 @@ TEST_F(RendererTest, MultiDrawGivesTheSamePixelsAsSingleDraws) {
       r.end_frame();
     }
     images[multi] = r.read_ids();
+    colours[multi] = r.read_rgba();
+    depths[multi] = r.read_depth();
     EXPECT_EQ(r.stats().draw_calls, 8u);
   }
+  // The two programs fetch per-draw data differently (uniforms / object
+  // buffer): the ids, colours and depths must not differ by a bit.
   EXPECT_EQ(images[0], images[1]);
+  EXPECT_EQ(colours[0], colours[1]);
+  EXPECT_EQ(depths[0], depths[1]);
   EXPECT_EQ(ids_in(images[1]), (std::set<ObjectId>{0, 2, 3}));
 }
 

@@ -34,48 +34,64 @@ class ScopedTimer {
   Clock::time_point t0_;
 };
 
-const char* kSceneVertex = R"(#version 450 core
+// The scene pass. Per-draw data is fetched once per draw, never per vertex
+// or fragment: with one draw per object the object's matrix and id are
+// uniforms set with the draw (as scene-graph engines do); under
+// OCCULL_MULTI_DRAW (one multi-draw per material run) they come from the
+// object buffer, indexed by the instance attribute. The material is a
+// uniform in both: every draw or multi-draw covers one material.
+const char* kSceneVertex = R"(
 layout(location = 0) in vec3 a_position;
 layout(location = 1) in vec3 a_normal;
+#ifdef OCCULL_MULTI_DRAW
 layout(location = 2) in uint a_object;
 layout(std430, binding = 0) readonly buffer Objects { mat4 models[]; };
+flat out uint v_object;
+#else
+uniform mat4 u_model;
+#endif
 uniform mat4 u_view_proj;
 out vec3 v_world;
 out vec3 v_normal;
-flat out uint v_object;
 void main() {
+#ifdef OCCULL_MULTI_DRAW
   mat4 m = models[a_object];
+  v_object = a_object;
+#else
+  mat4 m = u_model;
+#endif
   vec4 world = m * vec4(a_position, 1.0);
   v_world = world.xyz;
   v_normal = mat3(m) * a_normal;
-  v_object = a_object;
   gl_Position = u_view_proj * world;
 }
 )";
 
 // Shading cost: `lights` extra point lights, placed around the fragment by a
 // fixed pattern, each evaluated with a full Blinn-Phong term.
-const char* kSceneFragment = R"(#version 450 core
-struct MaterialData { vec4 color; ivec4 params; };
-layout(std430, binding = 1) readonly buffer Materials { MaterialData materials[]; };
-uniform uint u_material;
+const char* kSceneFragment = R"(
+uniform vec4 u_color;
+uniform int u_lights;
 uniform vec3 u_eye;
 uniform vec3 u_background;
 uniform float u_fog_distance;
+#ifdef OCCULL_MULTI_DRAW
+flat in uint v_object;
+#else
+uniform uint u_object;
+#endif
 in vec3 v_world;
 in vec3 v_normal;
-flat in uint v_object;
 layout(location = 0) out vec4 o_color;
 layout(location = 1) out uint o_id;
 void main() {
-  MaterialData m = materials[u_material];
   vec3 n = normalize(v_normal);
   vec3 to_eye = normalize(u_eye - v_world);
   const vec3 sun = normalize(vec3(0.45, 0.8, 0.35));
   float diffuse = max(dot(n, sun), 0.0);
   float sky = 0.5 + 0.5 * n.y;
-  vec3 c = m.color.rgb * (0.25 + 0.25 * sky + 0.6 * diffuse);
-  for (int i = 0; i < m.params.x; ++i) {
+  vec3 c = u_color.rgb * (0.25 + 0.25 * sky + 0.6 * diffuse);
+  for (int i = 0; i < u_lights; ++i) {
     float fi = float(i);
     vec3 light = v_world + vec3(sin(fi * 1.7) * 8.0, 4.0 + 2.0 * cos(fi * 2.3), cos(fi * 1.3) * 8.0);
     vec3 l = light - v_world;
@@ -83,13 +99,16 @@ void main() {
     l *= inversesqrt(d2);
     vec3 h = normalize(l + to_eye);
     float spec = pow(max(dot(n, h), 0.0), 32.0);
-    c += (m.color.rgb * max(dot(n, l), 0.0) + vec3(spec)) * (0.4 / (1.0 + 0.08 * d2)) /
-         float(m.params.x);
+    c += (u_color.rgb * max(dot(n, l), 0.0) + vec3(spec)) * (0.4 / (1.0 + 0.08 * d2)) / float(u_lights);
   }
   float fog = clamp(length(u_eye - v_world) / u_fog_distance, 0.0, 1.0);
   c = mix(c, u_background, fog * fog * 0.6);
-  o_color = vec4(c, m.color.a);
+  o_color = vec4(c, u_color.a);
+#ifdef OCCULL_MULTI_DRAW
   o_id = v_object + 1u;
+#else
+  o_id = u_object + 1u;
+#endif
 }
 )";
 
@@ -163,9 +182,9 @@ struct MeshRange {
   GLint base_vertex = 0;
 };
 
-struct alignas(16) MaterialData {
-  glm::vec4 color;
-  glm::ivec4 params;
+struct MaterialData {
+  glm::vec4 color;  // alpha 1 for opaque materials
+  GLint lights = 0;  // shading cost: extra lights evaluated per fragment
 };
 
 GLenum query_target(QueryMode mode) {
@@ -237,9 +256,11 @@ struct Renderer::Impl {
   GLenum target = GL_SAMPLES_PASSED;
 
   GLuint vertex_buffer = 0, index_buffer = 0, object_index_buffer = 0;
-  GLuint object_buffer = 0, material_buffer = 0;
+  GLuint object_buffer = 0;  // model matrices, read by the multi-draw program only
+  std::vector<MaterialData> materials;
   GLuint scene_vao = 0, scene_program = 0;
-  GLint u_scene_view_proj = -1, u_material = -1, u_eye = -1, u_background = -1, u_fog = -1;
+  GLint u_scene_view_proj = -1, u_color = -1, u_lights = -1, u_model = -1, u_object = -1, u_eye = -1,
+        u_background = -1, u_fog = -1;
   GLuint cube_vertices = 0, box_buffer = 0;
   GLuint query_vao = 0, query_program = 0;
   GLint u_query_view_proj = -1, u_query_eye = -1, u_query_half_viewport = -1, u_query_margin = -1;
@@ -359,16 +380,11 @@ void Renderer::Impl::create_scene_buffers() {
   glNamedBufferStorage(object_buffer, GLsizeiptr(models.size() * sizeof(glm::mat4)), models.data(),
                        GL_DYNAMIC_STORAGE_BIT);
 
-  std::vector<MaterialData> materials;
   for (const Material& m : scene.materials()) {
     glm::vec4 color = m.color;
     if (!m.translucent) color.a = 1.0f;
-    materials.push_back({color, glm::ivec4(std::max(0, m.shading_cost), 0, 0, 0)});
+    materials.push_back({color, std::max(0, m.shading_cost)});
   }
-  if (materials.empty()) materials.push_back({glm::vec4(1.0f), glm::ivec4(0)});
-  glCreateBuffers(1, &material_buffer);
-  glNamedBufferStorage(material_buffer, GLsizeiptr(materials.size() * sizeof(MaterialData)),
-                       materials.data(), 0);
 
   glCreateVertexArrays(1, &scene_vao);
   glVertexArrayVertexBuffer(scene_vao, 0, vertex_buffer, 0, 6 * sizeof(float));
@@ -378,16 +394,23 @@ void Renderer::Impl::create_scene_buffers() {
   glVertexArrayAttribBinding(scene_vao, 1, 0);
   glEnableVertexArrayAttrib(scene_vao, 0);
   glEnableVertexArrayAttrib(scene_vao, 1);
-  glVertexArrayVertexBuffer(scene_vao, 1, object_index_buffer, 0, sizeof(std::uint32_t));
-  glVertexArrayBindingDivisor(scene_vao, 1, 1);
-  glVertexArrayAttribIFormat(scene_vao, 2, 1, GL_UNSIGNED_INT, 0);
-  glVertexArrayAttribBinding(scene_vao, 2, 1);
-  glEnableVertexArrayAttrib(scene_vao, 2);
+  if (options.multi_draw) {  // the object index of each multi-draw command's instance
+    glVertexArrayVertexBuffer(scene_vao, 1, object_index_buffer, 0, sizeof(std::uint32_t));
+    glVertexArrayBindingDivisor(scene_vao, 1, 1);
+    glVertexArrayAttribIFormat(scene_vao, 2, 1, GL_UNSIGNED_INT, 0);
+    glVertexArrayAttribBinding(scene_vao, 2, 1);
+    glEnableVertexArrayAttrib(scene_vao, 2);
+  }
   glVertexArrayElementBuffer(scene_vao, index_buffer);
 
-  scene_program = make_program("scene", kSceneVertex, kSceneFragment);
+  const std::string header = options.multi_draw ? "#version 450 core\n#define OCCULL_MULTI_DRAW 1\n"
+                                                 : "#version 450 core\n";
+  scene_program = make_program("scene", header + kSceneVertex, header + kSceneFragment);
   u_scene_view_proj = glGetUniformLocation(scene_program, "u_view_proj");
-  u_material = glGetUniformLocation(scene_program, "u_material");
+  u_color = glGetUniformLocation(scene_program, "u_color");
+  u_lights = glGetUniformLocation(scene_program, "u_lights");
+  u_model = glGetUniformLocation(scene_program, "u_model");    // -1 under multi-draw
+  u_object = glGetUniformLocation(scene_program, "u_object");  // -1 under multi-draw
   u_eye = glGetUniformLocation(scene_program, "u_eye");
   u_background = glGetUniformLocation(scene_program, "u_background");
   u_fog = glGetUniformLocation(scene_program, "u_fog_distance");
@@ -491,7 +514,6 @@ void Renderer::Impl::establish_frame_state() const {
   // a bound query buffer makes glGetQueryObject write into it instead of
   // returning the result.
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, object_buffer);
-  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, material_buffer);
   glBindBuffer(GL_QUERY_BUFFER, 0);
   glBindBuffer(GL_DRAW_INDIRECT_BUFFER, indirect_buffer);
 }
@@ -543,7 +565,9 @@ void Renderer::Impl::draw_objects(std::span<const ObjectId> ids, BackendStats& s
     std::size_t end = begin + 1;
     while (end < ids.size() && scene.object(ids[end]).material == material) ++end;
     if (material != bound_material) {
-      glUniform1ui(u_material, material);
+      const MaterialData& m = materials[material];
+      glUniform4fv(u_color, 1, glm::value_ptr(m.color));
+      glUniform1i(u_lights, m.lights);
       bound_material = material;
       ++stats.material_changes;
     }
@@ -552,11 +576,13 @@ void Renderer::Impl::draw_objects(std::span<const ObjectId> ids, BackendStats& s
       multi_draw(run);
     } else {
       for (ObjectId id : run) {
-        const MeshRange& r = meshes[scene.object(id).mesh];
-        glDrawElementsInstancedBaseVertexBaseInstance(
-            GL_TRIANGLES, r.index_count, GL_UNSIGNED_INT,
-            reinterpret_cast<const void*>(r.first_index * sizeof(std::uint32_t)), 1,
-            r.base_vertex, id);
+        const Object& o = scene.object(id);
+        const MeshRange& r = meshes[o.mesh];
+        glUniformMatrix4fv(u_model, 1, GL_FALSE, glm::value_ptr(o.transform));
+        glUniform1ui(u_object, id);
+        glDrawElementsBaseVertex(GL_TRIANGLES, r.index_count, GL_UNSIGNED_INT,
+                                 reinterpret_cast<const void*>(r.first_index * sizeof(std::uint32_t)),
+                                 r.base_vertex);
       }
     }
     for (ObjectId id : run) stats.triangles += scene.object(id).triangles;
@@ -586,6 +612,7 @@ void Renderer::Impl::multi_draw(std::span<const ObjectId> ids) {
 }
 
 void Renderer::Impl::upload_dynamic_transforms() {
+  if (!options.multi_draw) return;  // single draws pass each matrix with its draw
   for (ObjectId id : scene.dynamic_objects()) {
     glNamedBufferSubData(object_buffer, GLintptr(id * sizeof(glm::mat4)), sizeof(glm::mat4),
                          glm::value_ptr(scene.object(id).transform));
@@ -612,7 +639,7 @@ Renderer::~Renderer() {
   if (g.timer) glDeleteQueries(1, &g.timer);
   glDeleteQueries(1, &g.truth_query);
   const GLuint buffers[] = {g.vertex_buffer, g.index_buffer,  g.object_index_buffer,
-                            g.object_buffer, g.material_buffer, g.cube_vertices,
+                            g.object_buffer, g.cube_vertices,
                             g.box_buffer,    g.indirect_buffer};
   glDeleteBuffers(GLsizei(std::size(buffers)), buffers);
   const GLuint vaos[] = {g.scene_vao, g.query_vao};
