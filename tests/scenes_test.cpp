@@ -3,7 +3,10 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+
+#include <glm/trigonometric.hpp>
 
 using namespace occull;
 
@@ -118,5 +121,28 @@ TEST(Scenes, UnknownPathListsTheValidOnes) {
     FAIL();
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("overview, glide"), std::string::npos);
+  }
+}
+
+TEST(Scenes, TrackIsThousandsOfSmallMeshesAlongARoadTheLapFollows) {
+  const SceneBundle track = make_scene("track");
+  const auto objects = track.scene.objects();
+  ASSERT_GT(objects.size(), 5000u);
+  std::vector<std::uint32_t> triangles;
+  for (const auto& o : objects) triangles.push_back(o.triangles);
+  std::nth_element(triangles.begin(), triangles.begin() + std::ptrdiff_t(triangles.size() / 2), triangles.end());
+  EXPECT_LE(triangles[triangles.size() / 2], 64u) << "the median object is a small mesh";
+  const CameraPath& lap = track.path("lap");
+  float previous_yaw = lap.sample(0.0).yaw;
+  for (int k = 0; k < 400; ++k) {
+    const CameraPose p = lap.sample(lap.frame_time(k, 400));
+    EXPECT_NEAR(p.position.y, 1.2f, 0.01f) << "frame " << k;  // on the flat road, at eye height
+    bool on_road = false;
+    for (const auto& o : objects)
+      on_road = on_road || (track.scene.material(o.material).name == "asphalt" &&
+                            o.bounds.grown(0.5f).contains({p.position.x, 0.0f, p.position.z}));
+    EXPECT_TRUE(on_road) << "frame " << k << " is off the road";
+    EXPECT_LT(std::abs(p.yaw - previous_yaw), glm::radians(15.0f)) << "frame " << k << ": the lap spins";
+    previous_yaw = p.yaw;
   }
 }

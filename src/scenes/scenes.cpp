@@ -21,6 +21,7 @@ const std::vector<Generator>& generators() {
   static const std::vector<Generator> all = {
       {scenes::city_info(), &scenes::make_city},
       {scenes::field_info(), &scenes::make_field},
+      {scenes::track_info(), &scenes::make_track},
       {scenes::adversarial_info(), &scenes::make_adversarial},
   };
   return all;

@@ -17,6 +17,9 @@ SceneBundle make_city(const Params& params);
 SceneInfo field_info();
 SceneBundle make_field(const Params& params);
 
+SceneInfo track_info();
+SceneBundle make_track(const Params& params);
+
 SceneInfo adversarial_info();
 SceneBundle make_adversarial(const Params& params);
 
