@@ -1,5 +1,6 @@
 // Runs the occull tool and checks exit codes and messages.
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include <array>
 #include <filesystem>
@@ -58,7 +59,8 @@ TEST(Cli, HelpOnEveryCommandNamesItsOptions) {
       {"algos", {"--help"}},
       {"path", {"--scene", "--path", "--out"}},
       {"bench", {"--scene", "--path", "--algo", "--frames", "--fps", "--start", "--size", "--query-mode",
-                 "--query-raster", "--query-margin", "--draw", "--verify", "--repeat", "--model", "--json"}},
+                 "--query-raster", "--query-margin", "--draw", "--verify", "--repeat", "--model", "--json",
+                 "--suite", "--malloc"}},
       {"calibrate", {"--size", "--repeats", "--out", "--check"}},
       {"render", {"--scene", "--frame", "--fps", "--out"}}};
   for (const auto& [cmd, options] : commands) {
@@ -422,4 +424,39 @@ TEST(Cli, BenchNamesTheAllocatorPolicyAndSaysWhereTheTimeGoes) {
   const CliRun bad = run(std::string("bench ") + kTinyCity + " --frames 1 --algo vfc --no-report --malloc tcmalloc");
   EXPECT_EQ(bad.code, 2) << bad.output;
   EXPECT_NE(bad.output.find("engine, system"), std::string::npos) << bad.output;
+}
+
+TEST(Cli, QuickSuiteRunsEveryEntryAndSummarisesEachCuller) {
+  const std::string dir = std::filesystem::temp_directory_path() / "occull-cli-suite";
+  std::filesystem::remove_all(dir);
+  const CliRun r = run("bench --suite quick --algo vfc,chcpp,oracle --frames 2 --warmup 0 --size 64x48 --report " +
+                       dir + " --json " + dir + ".json");
+  ASSERT_EQ(r.code, 0) << r.output;
+  for (const char* entry : {"== 1. city", "== 2. field", "== 3. track"})
+    EXPECT_NE(r.output.find(entry), std::string::npos) << entry;
+  EXPECT_NE(r.output.find("suite quick — 3 of 3 entries ran"), std::string::npos) << r.output;
+  const std::vector<std::string> chcpp = table_row(r.output.substr(r.output.find("geomean/vfc")), "chcpp");
+  ASSERT_GE(chcpp.size(), 3u) << r.output;
+  EXPECT_EQ(chcpp[1], "3") << "chcpp ran in every entry";
+  std::ifstream in(dir + ".json");
+  const nlohmann::json doc = nlohmann::json::parse(in);
+  EXPECT_EQ(doc["suite"], "quick");
+  ASSERT_EQ(doc["runs"].size(), 3u);
+  ASSERT_EQ(doc["summary"].size(), 3u);
+  // vfc's ratio to itself is 1 in every entry, so its geometric mean is too.
+  EXPECT_DOUBLE_EQ(doc["summary"][0]["geomean_to_vfc"].get<double>(), 1.0);
+  EXPECT_EQ(doc["summary"][2]["algorithm"], "oracle");
+  for (const char* file : {"suite.md", "suite.json", "ratio_to_vfc.svg", "ratio_to_oracle.svg"})
+    EXPECT_TRUE(std::filesystem::exists(std::filesystem::path(dir) / file)) << file;
+  std::filesystem::remove_all(dir);
+  std::filesystem::remove(dir + ".json");
+}
+
+TEST(Cli, UnknownSuiteListsTheValidOnesAndASuiteExcludesAScene) {
+  const CliRun unknown = run("bench --suite nightly --frames 1");
+  EXPECT_EQ(unknown.code, 2) << unknown.output;
+  EXPECT_NE(unknown.output.find("valid suites: default, quick"), std::string::npos) << unknown.output;
+  const CliRun both = run("bench --suite quick --scene field --frames 1");
+  EXPECT_EQ(both.code, 2) << both.output;
+  EXPECT_NE(both.output.find("excludes"), std::string::npos) << both.output;
 }

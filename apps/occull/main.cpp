@@ -17,6 +17,7 @@
 #include "occull/harness.hpp"
 #include "occull/report.hpp"
 #include "occull/scenes.hpp"
+#include "occull/suite.hpp"
 
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
@@ -212,6 +213,7 @@ struct BenchArgs {
   bool no_report = false;
   bool model = false;
   std::string malloc_policy = "engine";
+  std::string suite;
 };
 
 bool parse_on_off(const std::string& flag, const std::string& s) {
@@ -245,6 +247,50 @@ void check_written(const std::ofstream& f, const std::string& path) {
   if (!f) throw occull::InputError(fmt::format("cannot write '{}'", path));
 }
 
+// `bench --suite NAME`: every entry of the suite with the same settings,
+// a table per entry, then the summary over all of them.
+int run_suite(const BenchArgs& a, occull::BenchConfig c, bool report) {
+  const occull::Suite& suite = occull::find_suite(a.suite);
+  if (!a.csv.empty()) throw occull::InputError("--csv is per scene; with --suite use --json or the report folder");
+  const auto json = open_output(a.json);
+  if (report) occull::prepare_report_folder(a.report);
+  std::vector<occull::BenchResult> results;
+  std::vector<std::string> skipped;
+  for (std::size_t i = 0; i < suite.entries.size(); ++i) {
+    const occull::SuiteEntry& e = suite.entries[i];
+    if (!e.needs_file.empty() && access(e.needs_file.c_str(), R_OK) != 0) {
+      skipped.push_back(fmt::format("{} / {} ({} is missing: make data fetches it)", e.scene, e.path, e.needs_file));
+      std::fprintf(stderr, "suite %s: skipping %s / %s: %s is missing (make data fetches it)\n", suite.name.c_str(),
+                   e.scene.c_str(), e.path.c_str(), e.needs_file.c_str());
+      continue;
+    }
+    std::fprintf(stderr, "suite %s: entry %zu of %zu: %s / %s\n", suite.name.c_str(), i + 1, suite.entries.size(),
+                 e.scene.c_str(), e.path.c_str());
+    c.scene = e.scene;
+    c.path = e.path;
+    Progress progress;
+    results.push_back(occull::run_bench(c, std::ref(progress)));
+    std::cout << fmt::format("== {}. {} / {}\n", i + 1, e.scene, e.path);
+    occull::print_table(results.back(), std::cout);
+    std::cout << "\n";
+    std::cout.flush();
+  }
+  occull::print_suite_summary(suite, results, skipped, std::cout);
+  std::cout.flush();
+  if (json) {
+    occull::write_suite_json(suite, results, skipped, *json);
+    json->flush();
+    check_written(*json, a.json);
+  }
+  if (report) {
+    const auto files = occull::write_suite_report(suite, results, skipped, a.report);
+    std::fprintf(stderr, "report: %s/suite.md (%zu files)\n", a.report.c_str(), files.size());
+  }
+  for (const occull::BenchResult& r : results)
+    if (!occull::verification_failures(r).empty()) return kExitVerificationFailed;
+  return 0;
+}
+
 int cmd_bench(const BenchArgs& a) {
   occull::BenchConfig c;
   c.allocator = occull::apply_allocator_policy(occull::parse_allocator_policy(a.malloc_policy));
@@ -269,6 +315,7 @@ int cmd_bench(const BenchArgs& a) {
   c.verify = parse_on_off("--verify", a.verify);
   c.model = a.model;
   const bool report = !a.no_report && !a.report.empty();
+  if (!a.suite.empty()) return run_suite(a, c, report);
   const auto json = open_output(a.json);
   const auto csv = open_output(a.csv);
   if (report) occull::prepare_report_folder(a.report);
@@ -471,6 +518,10 @@ int main(int argc, char** argv) {
 
   CalibrateArgs calibrate;
   b->add_option("--malloc", bench.malloc_policy, kMallocHelp)->capture_default_str();
+  auto* suite_opt = b->add_option("--suite", bench.suite,
+                                  "run a fixed list of scene/path pairs instead of one, with a table each and a summary "
+                                  "over all (geometric mean and worst ratio to vfc and oracle per culler): default, quick");
+  suite_opt->excludes(b->get_option("--scene"))->excludes(b->get_option("--path"));
   auto* cal = app.add_subcommand("calibrate",
                                  "measure the NOHC hardware cost model on this renderer and cache it");
   cal->add_option("--malloc", calibrate.malloc_policy, kMallocHelp)->capture_default_str();

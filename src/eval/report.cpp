@@ -1,6 +1,7 @@
 #include "occull/report.hpp"
 
 #include "occull/error.hpp"
+#include "report_internal.hpp"
 #include "svg_chart.hpp"
 
 #include <fmt/format.h>
@@ -155,7 +156,7 @@ void print_table(const BenchResult& r, std::ostream& out) {
          "culling cost.\n";
 }
 
-void write_json(const BenchResult& r, std::ostream& out) {
+nlohmann::ordered_json detail::bench_json(const BenchResult& r) {
   using nlohmann::ordered_json;
   ordered_json doc;
   doc["device"] = {{"vendor", r.device.vendor},
@@ -223,8 +224,10 @@ void write_json(const BenchResult& r, std::ostream& out) {
                      {"model_ms_per_frame", r.modelled ? ordered_json(a.model_ms_per_frame) : ordered_json()}});
   }
   doc["algorithms"] = algos;
-  out << doc.dump(2) << "\n";
+  return doc;
 }
+
+void write_json(const BenchResult& r, std::ostream& out) { out << detail::bench_json(r).dump(2) << "\n"; }
 
 void write_csv(const BenchResult& r, std::ostream& out) {
   out << "algorithm,repeat,frame,frame_ms,cpu_ms,wait_ms,gpu_ms,queries,query_boxes,multiqueries,"
@@ -259,16 +262,19 @@ void prepare_report_folder(const std::string& dir) {
   fs::remove(probe, ec);
 }
 
+std::string detail::write_report_file(const std::string& dir, const std::string& name, const std::string& text) {
+  const std::string path = (std::filesystem::path(dir) / name).string();
+  std::ofstream f(path, std::ios::binary);
+  f << text;
+  if (!f) throw InputError(fmt::format("cannot write '{}'", path));
+  return path;
+}
+
 std::vector<std::string> write_report(const BenchResult& r, const std::string& dir) {
-  namespace fs = std::filesystem;
   prepare_report_folder(dir);
   std::vector<std::string> written;
   const auto write = [&](const std::string& name, const std::string& text) {
-    const std::string path = (fs::path(dir) / name).string();
-    std::ofstream f(path, std::ios::binary);
-    f << text;
-    if (!f) throw InputError(fmt::format("cannot write '{}'", path));
-    written.push_back(path);
+    written.push_back(detail::write_report_file(dir, name, text));
   };
 
   const detail::LineChart frame_chart = chart(r, fmt::format("Frame time — {} / {}", r.scene, r.path),

@@ -1,0 +1,17 @@
+// Internal: pieces the bench report and the suite report share — the JSON
+// document of one bench result (write_json writes it; suite reports embed
+// it) and writing one file of a report folder.
+#pragma once
+
+#include "occull/harness.hpp"
+
+#include <nlohmann/json.hpp>
+
+namespace occull::detail {
+
+[[nodiscard]] nlohmann::ordered_json bench_json(const BenchResult& result);
+
+/// Writes `text` to dir/name and returns that path. Throws InputError when it cannot.
+std::string write_report_file(const std::string& dir, const std::string& name, const std::string& text);
+
+}  // namespace occull::detail
