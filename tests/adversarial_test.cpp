@@ -15,7 +15,7 @@ using namespace occull;
 namespace {
 
 constexpr int kFrames = 24;
-const char* const kCullers[] = {"stopwait", "chc", "chcpp", "chcpp:virtual_leaf=0", "nohc"};
+const char* const kCullers[] = {"stopwait", "chc", "chcpp", "chcpp:virtual_leaf=0", "nohc", "auto:trial=1:period=2"};
 
 Options fixed_profile() {
   Options o;

@@ -58,6 +58,13 @@ class Culler {
   /// Returns the culler's own counters; timings and backend counters are
   /// left for the caller to fill.
   virtual FrameStats render_frame(const View& view, Backend& backend) = 0;
+
+  /// Optional feedback: the owner calls it once the frame rendered by the
+  /// last render_frame() is complete, with what it measured (frame_ms at
+  /// least: CPU and GPU time of the whole frame, milliseconds). Adaptive
+  /// cullers (`auto`) learn from it; the others ignore it. Without it `auto`
+  /// falls back to its own time inside render_frame().
+  virtual void frame_finished(const FrameStats& measured) { (void)measured; }
 };
 
 struct OptionInfo {

@@ -20,6 +20,15 @@
 namespace occull {
 namespace {
 
+// Whether a run of `spec` uses NOHC's hardware profile: nohc itself, and
+// auto unless its candidates leave nohc out.
+bool needs_profile(const AlgorithmSpec& spec) {
+  if (spec.name == "nohc") return true;
+  if (spec.name != "auto") return false;
+  const auto it = spec.options.values().find("auto.candidates");
+  return it == spec.options.values().end() || it->second.find("nohc") != std::string::npos;
+}
+
 using Clock = std::chrono::steady_clock;
 
 double ms_between(Clock::time_point a, Clock::time_point b) {
@@ -148,6 +157,7 @@ FrameStats Session::run_frame(Culler& culler, const View& view, double time_s) {
   s.draw_calls = d.draw_calls;
   s.triangles = d.triangles;
   s.objects_rendered = d.objects_rendered;
+  culler.frame_finished(s);
   return s;
 }
 
@@ -197,7 +207,7 @@ std::vector<FrameTruth> Session::ground_truth(const CameraPath& path, int frames
 std::unique_ptr<Culler> Session::make(std::string_view spec, const Options& options) {
   AlgorithmSpec a = parse_algorithm_spec(spec, options);
   if (a.name == "oracle") return std::make_unique<detail::OracleCuller>(bundle_.scene);
-  if (a.name == "nohc" && !a.options.has("nohc.profile")) {
+  if (needs_profile(a) && !a.options.has("nohc.profile")) {
     (void)hardware_profile();
     a.options.set("nohc.profile", hardware_profile_path());
   }
@@ -463,7 +473,7 @@ BenchResult run_bench(const BenchConfig& config, const ProgressFn& progress) {
   std::string profile_path;
   for (const auto& n : names) {
     const AlgorithmSpec spec = parse_algorithm_spec(n, config.options);
-    if (spec.name != "nohc") continue;
+    if (!needs_profile(spec)) continue;
     if (spec.options.has("nohc.profile"))
       profile_path = spec.options.values().at("nohc.profile");
     else
