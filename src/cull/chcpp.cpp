@@ -87,6 +87,7 @@ ChcppConfig read_config(const Options& o) {
   c.shape.d_max = o.get_int("chcpp.d_max", c.shape.d_max, 0, 16);
   c.shape.s_max = float(o.get_double("chcpp.s_max", c.shape.s_max, 1.0, 100.0));
   c.common = read_common_options(o, "chcpp", c.common.virtual_leaf_triangles);
+  c.leaf_objects = std::uint32_t(o.get_int("chcpp.leaf_objects", int(c.leaf_objects), 0, 1 << 30));
   c.pkeep_min_samples = std::uint32_t(o.get_int("chcpp.pkeep_samples", int(c.pkeep_min_samples), 1, 1 << 24));
   c.flush_batches = o.get_bool("chcpp.flush", c.flush_batches);
   c.render_batch_triangles =
@@ -158,7 +159,14 @@ class ChcppCuller final : public Culler {
     bool single;  // re-queried alone after a failed multiquery
   };
 
-  bool is_leaf(NodeId n) const { return index_.bvh.is_leaf(n, config_.common.virtual_leaf_triangles); }
+  // A real leaf, or a virtual one: few triangles and few objects (a subtree
+  // of many small meshes spread far apart is no leaf: queried as one it is
+  // almost always visible and culls nothing).
+  bool is_leaf(NodeId n) const {
+    const BvhNode& node = index_.bvh.node(n);
+    return node.is_leaf() || (node.triangles <= config_.common.virtual_leaf_triangles &&
+                              (config_.leaf_objects == 0 || node.object_count <= config_.leaf_objects));
+  }
 
   void process_node(NodeId n) {
     ++f_.stats.nodes_visited;

@@ -19,6 +19,7 @@ struct ChcppConfig {
   std::uint32_t n_av = 6;         ///< frames between queries of a visible leaf
   QueryShape shape{true, 3, 1.4f};
   CommonOptions common{0, 1500};  ///< threshold 0; virtual leaves up to 1500 triangles
+  std::uint32_t leaf_objects = 0; ///< ... and at most this many objects (0: any number)
   std::uint32_t pkeep_min_samples = 20;  ///< tests at one i before the measured p_keep(i) is used
   std::uint64_t seed = 1;                ///< of the jitter
   bool flush_batches = true;             ///< Backend::flush() after each query batch

@@ -53,6 +53,7 @@ const std::vector<Entry>& registry() {
          {"d_max", "3", "tight bounds: levels below the node"},
          {"s_max", "1.4", "tight bounds: most total surface area, relative to the node's"},
          {"virtual_leaf", "1500", "subtrees with at most this many triangles count as leaves (0: off)"},
+         {"leaf_objects", "0", "... and with at most this many objects (0: any number; 8 cost more queries than it saved on track/lap)"},
          {"threshold", "0", "a node is visible when more samples (pixels) pass"},
          {"pkeep_samples", "20", "tests at persistence i before the measured p_keep(i) replaces the formula"},
          {"seed", "1", "random seed of the jitter"},
