@@ -6,7 +6,7 @@ BUILD ?= build
 JOBS ?= $(shell nproc)
 CMAKE_FLAGS ?=
 
-.PHONY: demo test test-asan deps data configure build install clean
+.PHONY: demo test test-asan deps data configure build install clean gpu-pack
 
 demo: build
 	./$(BUILD)/occull bench
@@ -37,6 +37,10 @@ build: configure
 PREFIX ?= /usr/local
 install: build
 	cmake --install $(BUILD) --prefix $(PREFIX)
+
+# A folder (.gpu/) to run occull on a GPU machine without a package registry (README, "On a GPU").
+gpu-pack: deps
+	./scripts/gpu-pack.sh .gpu
 
 clean:
 	rm -rf $(BUILD) $(BUILD)-asan

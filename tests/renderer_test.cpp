@@ -260,10 +260,15 @@ TEST_F(RendererTest, GpuTimeOfAFrameThatDrawsIsPositiveWhereTheDeviceHasATimer) 
 }
 
 TEST_F(RendererTest, MultiDrawGivesTheSamePixelsAsSingleDraws) {
-  Scene scene = test::box_scene({{{-3, -3, -11}, {3, 3, -10}},
-                                 {{-1, -1, -21}, {1, 1, -19}},
-                                 {{7, -1, -21}, {9, 1, -19}},
-                                 {{-9, -2, -30}, {-5, 2, -25}}});
+  // Four boxes, then a row of 20 more: runs of one material both shorter and
+  // longer than the renderer's shortest multi-draw (kMinMultiDrawRun, 16).
+  std::vector<Aabb> boxes = {{{-3, -3, -11}, {3, 3, -10}},
+                             {{-1, -1, -21}, {1, 1, -19}},
+                             {{7, -1, -21}, {9, 1, -19}},
+                             {{-9, -2, -30}, {-5, 2, -25}}};
+  for (int i = 0; i < 20; ++i)
+    boxes.push_back({{-10.0f + float(i), 14.0f, -40.0f}, {-9.5f + float(i), 14.5f, -39.0f}});
+  Scene scene = test::box_scene(boxes);
   const View view = make_view({{0, 0, 0}, 0, 0}, {60.0f, 0.1f, 100.0f}, kSize, kSize);
   std::vector<std::uint32_t> images[2];
   std::vector<std::uint8_t> colours[2];
@@ -272,23 +277,28 @@ TEST_F(RendererTest, MultiDrawGivesTheSamePixelsAsSingleDraws) {
     gl::RendererOptions o = small();
     o.multi_draw = multi == 1;
     gl::Renderer r(scene, o);
+    std::vector<ObjectId> row;
+    for (ObjectId id = 4; id < 24; ++id) row.push_back(id);
     for (int frame = 0; frame < 2; ++frame) {  // the second frame reuses the indirect buffer
       r.begin_frame(view);
-      const ObjectId all[] = {3, 0, 2, 1};
-      r.render(all);
+      const ObjectId four[] = {3, 0, 2, 1};
+      r.render(four);  // a short run
+      r.render(row);   // a long one: one multi-draw
       r.end_frame();
     }
     images[multi] = r.read_ids();
     colours[multi] = r.read_rgba();
     depths[multi] = r.read_depth();
-    EXPECT_EQ(r.stats().draw_calls, 8u);
+    EXPECT_EQ(r.stats().draw_calls, 48u);
   }
   // The two programs fetch per-draw data differently (uniforms / object
   // buffer): the ids, colours and depths must not differ by a bit.
   EXPECT_EQ(images[0], images[1]);
   EXPECT_EQ(colours[0], colours[1]);
   EXPECT_EQ(depths[0], depths[1]);
-  EXPECT_EQ(ids_in(images[1]), (std::set<ObjectId>{0, 2, 3}));
+  std::set<ObjectId> expected{0, 2, 3};
+  for (ObjectId id = 4; id < 24; ++id) expected.insert(id);
+  EXPECT_EQ(ids_in(images[1]), expected);
 }
 
 TEST_F(RendererTest, BoxAroundTheEyeIsVisible) {

@@ -203,7 +203,10 @@ struct DrawCommand {
   GLuint base_instance;
 };
 
-constexpr GLsizeiptr kBoxCapacity = 1 << 16;  // boxes per stream-buffer fill
+constexpr GLsizeiptr kBoxCapacity = 1 << 16;
+// Under --draw multi, material runs shorter than this are drawn one object
+// at a time (see draw_objects).
+constexpr std::size_t kMinMultiDrawRun = 16;  // boxes per stream-buffer fill
 
 // State glReadPixels depends on: the framebuffer read from, no pixel-pack
 // buffer (else it writes into that buffer), tight rows.
@@ -572,8 +575,18 @@ void Renderer::Impl::draw_objects(std::span<const ObjectId> ids, BackendStats& s
       ++stats.material_changes;
     }
     const auto run = ids.subspan(begin, end - begin);
-    if (options.multi_draw) {
+    if (options.multi_draw && run.size() >= kMinMultiDrawRun) {
       multi_draw(run);
+    } else if (options.multi_draw) {
+      // A short run: a buffer upload and an indirect draw cost more than the
+      // draws they replace. The multi-draw program reads the object index
+      // from the instance attribute, so each object is its own base instance.
+      for (ObjectId id : run) {
+        const MeshRange& r = meshes[scene.object(id).mesh];
+        glDrawElementsInstancedBaseVertexBaseInstance(
+            GL_TRIANGLES, r.index_count, GL_UNSIGNED_INT,
+            reinterpret_cast<const void*>(r.first_index * sizeof(std::uint32_t)), 1, r.base_vertex, id);
+      }
     } else {
       for (ObjectId id : run) {
         const Object& o = scene.object(id);
