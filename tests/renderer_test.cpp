@@ -121,6 +121,33 @@ TEST_F(RendererTest, ResultAvailableTurnsTrueAfterFinish) {
   EXPECT_GT(r.result(q), 0u);
 }
 
+TEST_F(RendererTest, FlushesCountSubmissionsIncludingPollsOfUnsubmittedQueries) {
+  WallScene w;
+  gl::Renderer r(w.scene, small());
+  r.begin_frame(w.view);
+  const Aabb beside[] = {w.scene.object(WallScene::beside).bounds};
+  const auto flushes = [&] { return r.stats().flushes; };
+  const QueryId a = r.issue_query(beside);
+  const QueryId b = r.issue_query(beside);
+  EXPECT_EQ(flushes(), 0u);
+  (void)r.result_available(a);  // not yet submitted: the driver flushes
+  EXPECT_EQ(flushes(), 1u);
+  (void)r.result_available(b);  // submitted by that same flush
+  (void)r.result_available(a);
+  EXPECT_EQ(flushes(), 1u);
+  const QueryId c = r.issue_query(beside);
+  r.flush();
+  EXPECT_EQ(flushes(), 2u);
+  (void)r.result(c);  // submitted by the explicit flush
+  EXPECT_EQ(flushes(), 2u);
+  const QueryId d = r.issue_query(beside);
+  (void)r.result(d);  // a read of an unsubmitted query flushes too
+  EXPECT_EQ(flushes(), 3u);
+  (void)r.result(a);
+  (void)r.result(b);
+  r.end_frame();
+}
+
 TEST_F(RendererTest, BoxCrossingTheNearPlaneIsVisible) {
   WallScene w;
   gl::Renderer r(w.scene, small());

@@ -29,6 +29,10 @@ struct BackendStats {
   std::uint64_t state_changes = 0;     ///< switches between rendering and querying state
   std::uint64_t material_changes = 0;  ///< material binds while rendering
   std::uint64_t blocking_waits = 0;    ///< result() calls that had to wait (not available yet)
+  /// Submissions to the device: flush() calls, and polls or reads of a
+  /// query issued after the last one (drivers flush for those). Each ends
+  /// a command batch; on llvmpipe each costs a thread wake-up and memory churn.
+  std::uint64_t flushes = 0;
   double wait_ms = 0.0;                ///< wall time blocked inside result(), milliseconds
   double backend_ms = 0.0;             ///< wall time inside any Backend call, milliseconds
 
@@ -37,7 +41,7 @@ struct BackendStats {
             a.objects_rendered - b.objects_rendered, a.render_flushes - b.render_flushes,
             a.queries - b.queries,             a.query_boxes - b.query_boxes,
             a.state_changes - b.state_changes, a.material_changes - b.material_changes,
-            a.blocking_waits - b.blocking_waits,
+            a.blocking_waits - b.blocking_waits, a.flushes - b.flushes,
             a.wait_ms - b.wait_ms,             a.backend_ms - b.backend_ms};
   }
 };

@@ -251,6 +251,7 @@ struct AlgorithmSummary {
   double extra_objects_per_frame = 0.0;  ///< over-rendering (verified runs)
   double wait_ms_per_frame = 0.0;
   double blocking_waits_per_frame = 0.0;  ///< query reads that had to wait (sync points)
+  double flushes_per_frame = 0.0;         ///< submissions to the device mid-frame (BackendStats::flushes)
   double cpu_ms_per_frame = 0.0;
   double gpu_ms_per_frame = 0.0;
   double model_ms_per_frame = 0.0;        ///< cost-model prediction (0 without --model)

@@ -33,6 +33,7 @@ struct FrameStats {
   std::uint64_t query_boxes = 0;
   std::uint64_t state_changes = 0;
   std::uint64_t blocking_waits = 0;  ///< query reads that had to wait for the device
+  std::uint64_t flushes = 0;         ///< submissions to the device (BackendStats::flushes)
   std::uint64_t material_changes = 0;
   std::uint64_t render_flushes = 0;
   std::uint64_t draw_calls = 0;

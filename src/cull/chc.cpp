@@ -12,7 +12,10 @@
 //
 // Options: threshold (pixels), skip (n_av: a visible leaf is assumed to
 // stay visible for n_av frames and queried again in frame n_av + 1),
-// virtual_leaf (triangles).
+// virtual_leaf (triangles), flush_every (queries are handed to the device
+// in groups and only those handed over are polled — the paper polls the
+// oldest query at every step, which makes a driver flush for each query;
+// flush_every=1 comes closest to that).
 #include "cullers.hpp"
 #include "traversal.hpp"
 
@@ -27,7 +30,8 @@ class ChcCuller final : public Culler {
       : index_(index),
         common_(read_common_options(options, "chc")),
         skip_(std::uint32_t(options.get_int("chc.skip", 0, 0, 1000))),
-        state_(index.bvh.size()) {}
+        state_(index.bvh.size()),
+        submitter_(std::uint32_t(options.get_int("chc.flush_every", 8, 1, 1 << 20))) {}
 
   FrameStats render_frame(const View& view, Backend& backend) override {
     ++frame_;
@@ -37,7 +41,10 @@ class ChcCuller final : public Culler {
     queue_.push(index_.bvh, Bvh::root(), view.eye);
     while (!queue_.empty() || !queries_.empty()) {
       // Handle returned queries; when there is nothing else to do, wait.
-      while (!queries_.empty() && (queue_.empty() || backend.result_available(queries_.front().id))) {
+      if (queue_.empty()) submitter_.submit(backend);
+      while (!queries_.empty() &&
+             (queue_.empty() ||
+              (submitter_.submitted(queries_.front().submission) && backend.result_available(queries_.front().id)))) {
         const Pending p = queries_.front();
         queries_.pop_front();
         handle_returned_query(p, backend.result(p.id));
@@ -77,6 +84,7 @@ class ChcCuller final : public Culler {
     QueryId id;
     NodeId node;
     bool previously_visible;
+    std::uint32_t submission;  // QuerySubmitter tag: polled only once handed to the device
   };
 
   bool is_leaf(NodeId n) const { return index_.bvh.is_leaf(n, common_.virtual_leaf_triangles); }
@@ -84,7 +92,8 @@ class ChcCuller final : public Culler {
   void query(NodeId n, bool previously_visible) {
     boxes_.clear();
     append_query_boxes(index_, n, {}, boxes_);
-    queries_.push_back({f_.backend->issue_query(boxes_), n, previously_visible});
+    const QueryId q = f_.backend->issue_query(boxes_);
+    queries_.push_back({q, n, previously_visible, submitter_.issued(*f_.backend)});
     ++f_.stats.query_batches;
   }
 
@@ -118,6 +127,7 @@ class ChcCuller final : public Culler {
   std::deque<Pending> queries_;
   std::vector<Aabb> boxes_;
   std::vector<ObjectId> objects_;
+  QuerySubmitter submitter_;
 };
 
 }  // namespace

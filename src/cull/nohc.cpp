@@ -67,12 +67,14 @@ struct NohcConfig {
   int max_parallel = 0;          // 0: N_q from the profile
   bool exact_area = true;        // projected box area instead of the paper's approximation
   std::uint32_t virtual_leaf = 0;
+  std::uint32_t flush_every = 8;  // queries handed to the device together
 };
 
 class NohcCuller final : public Culler {
  public:
   NohcCuller(const SceneIndex& index, const NohcConfig& config, HardwareProfile profile)
-      : index_(index), config_(config), hw_(std::move(profile)), nodes_(index.bvh.size()) {
+      : index_(index), config_(config), hw_(std::move(profile)), nodes_(index.bvh.size()),
+        submitter_(config.flush_every) {
     // Per node: draws, triangles, triangle-weighted shading cost, object surface area.
     const Bvh& bvh = index.bvh;
     for (NodeId n = NodeId(bvh.size()); n-- > 0;) {
@@ -103,6 +105,7 @@ class NohcCuller final : public Culler {
       if (distance_queue_.empty()) {
         if (!query_queue_.empty()) {
           flush_render_queue();
+          submitter_.submit(*f_.backend);
           handle_returned_query();  // nothing else to do: wait
         }
         continue;
@@ -131,6 +134,7 @@ class NohcCuller final : public Culler {
     QueryId id;
     NodeId node;
     bool wait;  // children held back until the answer
+    std::uint32_t submission;  // QuerySubmitter tag: polled only once handed to the device
   };
 
   bool is_leaf(NodeId n) const { return index_.bvh.is_leaf(n, config_.virtual_leaf); }
@@ -230,7 +234,8 @@ class NohcCuller final : public Culler {
       boxes_.clear();
       append_query_boxes(index_, n, {}, boxes_);
       const bool wait = previous == PreviousState::occluded;
-      query_queue_.push_back({f_.backend->issue_query(boxes_), n, wait});
+      const QueryId q = f_.backend->issue_query(boxes_);
+      query_queue_.push_back({q, n, wait, submitter_.issued(*f_.backend)});
       ++f_.stats.query_batches;
       info.frames_since_query = 0;
       if (!wait) process(n);
@@ -273,6 +278,7 @@ class NohcCuller final : public Culler {
 
   bool first_query_finished() {
     if (int(query_queue_.size()) >= max_parallel_) return true;  // the N_q rule
+    if (!submitter_.submitted(query_queue_.front().submission)) return false;  // cannot be done yet
     return f_.backend->result_available(query_queue_.front().id);
   }
 
@@ -316,6 +322,7 @@ class NohcCuller final : public Culler {
   std::vector<ObjectId> render_queue_;
   std::vector<Aabb> boxes_;
   std::vector<NodeId> cancel_stack_;
+  QuerySubmitter submitter_;
 };
 
 }  // namespace
@@ -329,6 +336,7 @@ std::unique_ptr<Culler> make_nohc(const SceneIndex& index, const Options& o) {
   c.max_parallel = o.get_int("nohc.max_parallel", c.max_parallel, 0, 100000);
   c.exact_area = o.get_bool("nohc.exact_area", c.exact_area);
   c.virtual_leaf = std::uint32_t(o.get_int("nohc.virtual_leaf", 0, 0, 1 << 30));
+  c.flush_every = std::uint32_t(o.get_int("nohc.flush_every", int(c.flush_every), 1, 1 << 20));
   const auto it = o.values().find("nohc.profile");
   if (it == o.values().end() || it->second.empty())
     throw InputError("nohc needs a hardware profile: run `occull calibrate` (occull bench does it "

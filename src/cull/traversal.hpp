@@ -124,6 +124,37 @@ class FrustumCache {
   const View* view_ = nullptr;
 };
 
+/// Hands a culler's queries to the device in groups of `every`. A query the
+/// device has not been handed cannot be done, and polling it would make the
+/// driver flush for that one query (on llvmpipe each flush wakes the
+/// rasterizer threads and churns memory: hundreds per frame cost more than
+/// the culling saves). So a culler polls a query only once submitted(), and
+/// calls submit() before it must wait.
+class QuerySubmitter {
+ public:
+  explicit QuerySubmitter(std::uint32_t every = 8) : every_(every) {}
+  /// Call after each issue_query; returns the tag to keep with the query.
+  std::uint32_t issued(Backend& backend) {
+    const std::uint32_t tag = round_;
+    if (++pending_ >= every_) submit(backend);
+    return tag;
+  }
+  /// Flushes the queries issued since the last submission, if any.
+  void submit(Backend& backend) {
+    if (pending_ == 0) return;
+    backend.flush();
+    ++round_;
+    pending_ = 0;
+  }
+  /// Whether the query issued with `tag` has been handed to the device.
+  [[nodiscard]] bool submitted(std::uint32_t tag) const { return tag != round_; }
+
+ private:
+  std::uint32_t every_;
+  std::uint32_t round_ = 0;
+  std::uint32_t pending_ = 0;
+};
+
 /// The eye-inside rule (DESIGN, seed 002): a box that, grown by the near
 /// plane radius, contains the eye is visible without a query — its query
 /// could miss the faces around the camera, and an object that close is

@@ -152,6 +152,7 @@ FrameStats Session::run_frame(Culler& culler, const View& view, double time_s) {
   s.query_boxes = d.query_boxes;
   s.state_changes = d.state_changes;
   s.blocking_waits = d.blocking_waits;
+  s.flushes = d.flushes;
   s.material_changes = d.material_changes;
   s.render_flushes = d.render_flushes;
   s.draw_calls = d.draw_calls;
@@ -362,6 +363,7 @@ std::vector<AlgorithmSummary> summarize_runs(std::span<const AlgorithmRun> runs)
         sums["extra_objects"] += double(f.extra_objects);
         sums["wait_ms"] += f.wait_ms;
         sums["blocking_waits"] += double(f.blocking_waits);
+        sums["flushes"] += double(f.flushes);
         sums["cpu_ms"] += f.cpu_ms;
         sums["gpu_ms"] += f.gpu_ms;
         sums["model_ms"] += f.model_ms;
@@ -412,6 +414,7 @@ std::vector<AlgorithmSummary> summarize_runs(std::span<const AlgorithmRun> runs)
     a.extra_objects_per_frame = med("extra_objects");
     a.wait_ms_per_frame = med("wait_ms");
     a.blocking_waits_per_frame = med("blocking_waits");
+    a.flushes_per_frame = med("flushes");
     a.cpu_ms_per_frame = med("cpu_ms");
     a.gpu_ms_per_frame = med("gpu_ms");
     a.model_ms_per_frame = med("model_ms");

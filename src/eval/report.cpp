@@ -128,13 +128,13 @@ void print_table(const BenchResult& r, std::ostream& out) {
   }
   if (r.verified) out << "\n";
   for (const std::string& line : verdict_lines(r)) out << line << "\n";
-  out << fmt::format("\nwhere the time goes (per frame)\n{:<{}} {:>7} {:>8} {:>8} {:>8} {:>7} {:>8} {:>8} {:>7}\n",
-                     "algorithm", w, "cpu ms", "us/node", "nodes", "wait ms", "waits", "gpu ms", "faults",
-                     "sys ms");
+  out << fmt::format("\nwhere the time goes (per frame)\n{:<{}} {:>7} {:>8} {:>8} {:>8} {:>7} {:>8} {:>8} {:>8} {:>7}\n",
+                     "algorithm", w, "cpu ms", "us/node", "nodes", "wait ms", "waits", "flushes", "gpu ms",
+                     "faults", "sys ms");
   for (const AlgorithmSummary& a : r.summaries)
-    out << fmt::format("{:<{}} {:>7.3f} {:>8.3f} {:>8.0f} {:>8.3f} {:>7.1f} {:>8.2f} {:>8.0f} {:>7.2f}\n", a.name, w,
-                       a.cpu_ms_per_frame, a.cpu_us_per_node, a.nodes_visited_per_frame, a.wait_ms_per_frame,
-                       a.blocking_waits_per_frame, a.gpu_ms_per_frame,
+    out << fmt::format("{:<{}} {:>7.3f} {:>8.3f} {:>8.0f} {:>8.3f} {:>7.1f} {:>8.1f} {:>8.2f} {:>8.0f} {:>7.2f}\n",
+                       a.name, w, a.cpu_ms_per_frame, a.cpu_us_per_node, a.nodes_visited_per_frame,
+                       a.wait_ms_per_frame, a.blocking_waits_per_frame, a.flushes_per_frame, a.gpu_ms_per_frame,
                        a.minor_faults_per_frame + a.major_faults_per_frame, a.kernel_ms_per_frame);
   if (r.modelled) {
     out << fmt::format("\ncost model (NOHC, profile {}): mean frame ms\n", r.profile_path);
@@ -151,7 +151,8 @@ void print_table(const BenchResult& r, std::ostream& out) {
          "queries, states (render<->query switches), draws, triangles: per frame. missed: objects "
          "visible in the ground truth but not rendered, summed over frames; wrong px: their pixels.\n"
          "cpu ms: the culler's own CPU time (outside backend calls); us/node: that per visited hierarchy node; "
-         "wait ms / waits: time and reads blocked on query results; gpu ms: timer queries; faults, sys ms: page "
+         "wait ms / waits: time and reads blocked on query results; flushes: submissions to the device mid-frame "
+         "(flush calls, and polls or reads of queries not yet submitted, which make the driver flush); gpu ms: timer queries; faults, sys ms: page "
          "faults and kernel CPU time of the whole process (driver threads too), allocator churn rather than "
          "culling cost.\n";
 }
@@ -215,6 +216,7 @@ nlohmann::ordered_json detail::bench_json(const BenchResult& r) {
                      {"longest_miss_frames", a.longest_miss_frames},
                      {"wait_ms_per_frame", a.wait_ms_per_frame},
                      {"blocking_waits_per_frame", a.blocking_waits_per_frame},
+                     {"flushes_per_frame", a.flushes_per_frame},
                      {"cpu_ms_per_frame", a.cpu_ms_per_frame},
                      {"gpu_ms_per_frame", a.gpu_ms_per_frame},
                      {"cpu_us_per_node", a.cpu_us_per_node},
@@ -233,7 +235,7 @@ void write_csv(const BenchResult& r, std::ostream& out) {
   out << "algorithm,repeat,frame,frame_ms,cpu_ms,wait_ms,gpu_ms,queries,query_boxes,multiqueries,"
          "failed_multiqueries,query_batches,state_changes,material_changes,render_flushes,"
          "draw_calls,triangles,objects_rendered,nodes_visited,truth_objects,missed_objects,"
-         "wrong_pixels,extra_objects,blocking_waits,model_ms,kernel_ms,minor_faults,major_faults\n";
+         "wrong_pixels,extra_objects,blocking_waits,model_ms,kernel_ms,minor_faults,major_faults,flushes\n";
   for (const AlgorithmRun& run : r.runs) {
     for (std::size_t k = 0; k < run.frames.size(); ++k) {
       const FrameStats& f = run.frames[k];
@@ -243,7 +245,7 @@ void write_csv(const BenchResult& r, std::ostream& out) {
                          f.state_changes, f.material_changes, f.render_flushes, f.draw_calls,
                          f.triangles, f.objects_rendered, f.nodes_visited, f.truth_objects,
                          f.missed_objects, f.wrong_pixels, f.extra_objects, f.blocking_waits, f.model_ms,
-                         f.kernel_ms, f.minor_faults, f.major_faults);
+                         f.kernel_ms, f.minor_faults, f.major_faults, f.flushes);
     }
   }
 }

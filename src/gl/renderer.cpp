@@ -206,7 +206,8 @@ struct DrawCommand {
 constexpr GLsizeiptr kBoxCapacity = 1 << 16;
 // Under --draw multi, material runs shorter than this are drawn one object
 // at a time (see draw_objects).
-constexpr std::size_t kMinMultiDrawRun = 16;  // boxes per stream-buffer fill
+constexpr std::size_t kMinMultiDrawRun = 16;
+constexpr QueryId kNoQuery = ~QueryId(0);  // boxes per stream-buffer fill
 
 // State glReadPixels depends on: the framebuffer read from, no pixel-pack
 // buffer (else it writes into that buffer), tight rows.
@@ -278,6 +279,16 @@ struct Renderer::Impl {
 
   std::vector<MeshRange> meshes;
   std::vector<GLuint> query_names;  // QueryId -> GL name (all of `target`)
+  // Which queries the device has been handed (a flush since their issue):
+  // polling or reading one that was not makes the driver flush.
+  std::vector<std::uint64_t> query_serial;  // QueryId -> issue_serial when issued
+  std::uint64_t issue_serial = 0;           // queries issued so far
+  std::uint64_t flushed_serial = 0;         // issue_serial at the last flush
+  void note_flush_for(QueryId q, BackendStats& stats) {
+    if (q != kNoQuery && query_serial[q] <= flushed_serial) return;
+    ++stats.flushes;
+    flushed_serial = issue_serial;
+  }
   std::vector<QueryId> free_queries;
   std::size_t in_flight = 0;
   GLsizeiptr box_offset = 0;  // next free box in the stream buffer
@@ -768,11 +779,13 @@ QueryId Renderer::issue_query(std::span<const Aabb> boxes) {
     glCreateQueries(g.target, 1, &name);
     q = QueryId(g.query_names.size());
     g.query_names.push_back(name);
+    g.query_serial.push_back(0);
   } else {
     q = g.free_queries.back();
     g.free_queries.pop_back();
   }
   ++g.in_flight;
+  g.query_serial[q] = ++g.issue_serial;
   // A box around the eye shows only back faces: draw both sides for it.
   bool around_eye = false;
   for (const Aabb& b : boxes) around_eye = around_eye || b.grown(g.near_radius).contains(g.eye);
@@ -808,6 +821,7 @@ bool Renderer::result_available(QueryId q) {
   Impl& g = *impl_;
   ScopedTimer timer(stats_.backend_ms);
   GLuint available = GL_FALSE;
+  g.note_flush_for(q, stats_);
   glBindBuffer(GL_QUERY_BUFFER, 0);  // results may be read between frames too
   glGetQueryObjectuiv(g.query_names[q], GL_QUERY_RESULT_AVAILABLE, &available);
   return available == GL_TRUE;
@@ -817,6 +831,7 @@ std::uint64_t Renderer::result(QueryId q) {
   Impl& g = *impl_;
   const auto t0 = Clock::now();
   GLuint available = GL_FALSE;
+  g.note_flush_for(q, stats_);
   glBindBuffer(GL_QUERY_BUFFER, 0);  // results may be read between frames too
   glGetQueryObjectuiv(g.query_names[q], GL_QUERY_RESULT_AVAILABLE, &available);
   if (available != GL_TRUE) ++stats_.blocking_waits;
@@ -832,6 +847,7 @@ std::uint64_t Renderer::result(QueryId q) {
 
 void Renderer::flush() {
   ScopedTimer timer(stats_.backend_ms);
+  impl_->note_flush_for(kNoQuery, stats_);
   glFlush();
 }
 
