@@ -269,7 +269,16 @@ int run_suite(const BenchArgs& a, occull::BenchConfig c, bool report) {
     c.scene = e.scene;
     c.path = e.path;
     Progress progress;
-    results.push_back(occull::run_bench(c, std::ref(progress)));
+    try {
+      results.push_back(occull::run_bench(c, std::ref(progress)));
+    } catch (const occull::InputError& error) {
+      // One entry that cannot run (a map missing from the archive) must
+      // not throw away the others' results.
+      skipped.push_back(fmt::format("{} / {} ({})", e.scene, e.path, error.what()));
+      std::fprintf(stderr, "suite %s: skipping %s / %s: %s\n", suite.name.c_str(), e.scene.c_str(),
+                   e.path.c_str(), error.what());
+      continue;
+    }
     std::cout << fmt::format("== {}. {} / {}\n", i + 1, e.scene, e.path);
     occull::print_table(results.back(), std::cout);
     std::cout << "\n";

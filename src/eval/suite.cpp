@@ -34,7 +34,7 @@ std::span<const Suite> suites() {
   static const std::vector<Suite> all = {
       {"default",
        "where culling pays and where it does not: the city walked, flown over and turned in, a city five "
-       "times as large, open fields, three OpenArena maps (after make data) and the race track of small "
+       "times as large, open fields, three OpenArena maps (oasago2, ctf_inyard, wrackdm17; after make data) and the race track of small "
        "meshes",
        {{"city", "street", ""},
         {"city", "flyover", ""},
@@ -44,7 +44,7 @@ std::span<const Suite> suites() {
         {"field", "overview", ""},
         {q3("oasago2"), "tour", kMaps},
         {q3("ctf_inyard"), "tour", kMaps},
-        {q3("oa_thor"), "tour", kMaps},
+        {q3("wrackdm17"), "tour", kMaps},
         {"track", "lap", ""}}},
       {"quick",
        "the default suite's kinds of scene at a size CI can run in seconds: a small city, a small field, a "
