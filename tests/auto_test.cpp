@@ -34,10 +34,17 @@ std::vector<std::size_t> run(detail::AutoSchedule& s, const std::vector<double>&
 
 TEST(AutoSchedule, TriesEveryCandidateThenKeepsTheCheapest) {
   detail::AutoSchedule s(config(), 3);
-  const auto ran = run(s, {5.0, 2.0, 8.0}, 6);
+  const auto ran = run(s, {5.0, 2.0, 3.0}, 6);
   EXPECT_EQ(ran, (std::vector<std::size_t>{0, 0, 1, 1, 2, 2}));
   EXPECT_EQ(s.current(), 1u);
   EXPECT_EQ(s.next(), 1u);
+}
+
+TEST(AutoSchedule, ATryMoreThanTwiceTheBestCostEndsAfterOneFrame) {
+  detail::AutoSchedule s(config(), 3);
+  const auto ran = run(s, {2.0, 9.0, 3.0}, 5);
+  EXPECT_EQ(ran, (std::vector<std::size_t>{0, 0, 1, 2, 2}));
+  EXPECT_EQ(s.current(), 0u);
 }
 
 TEST(AutoSchedule, SwitchesWhenAChallengerBecomesCheaperByTheMargin) {

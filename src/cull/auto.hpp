@@ -9,7 +9,9 @@
 namespace occull::detail {
 
 struct AutoConfig {
-  std::vector<std::string> candidates{"vfc", "chcpp", "nohc"};
+  // Tried in this order at the start: chcpp first, so that a candidate far
+  // worse than it (vfc in a dense city) is dropped after one frame.
+  std::vector<std::string> candidates{"chcpp", "vfc", "nohc"};
   int trial = 2;          ///< frames a candidate runs when tried (its cost: their median)
   int period = 50;        ///< frames between tries of a challenger
   double margin = 0.05;   ///< a challenger must be this much cheaper to take over (hysteresis)
@@ -19,7 +21,8 @@ struct AutoConfig {
 /// Which candidate runs each frame, from the measured cost of the frames
 /// run so far. Starts by trying each candidate in order; then keeps the
 /// cheapest, tries another one every `period` frames for `trial` frames and
-/// switches when it was cheaper by `margin`. A challenger that loses waits
+/// switches when it was cheaper by `margin`. A try whose frame costs more
+/// than twice the best known cost ends after that frame. A challenger that loses waits
 /// twice as long before its next try (up to 16 periods), so a candidate
 /// that never pays costs almost nothing to keep watching.
 class AutoSchedule {

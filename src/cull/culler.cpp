@@ -74,10 +74,10 @@ const std::vector<Entry>& registry() {
          {"virtual_leaf", "0", "subtrees with at most this many triangles count as leaves (0: off)"}}},
        &detail::make_nohc},
       {{"auto",
-        "adaptive: runs the cheapest of vfc, chcpp and nohc for this view, learnt from the measured frame times, "
+        "adaptive: runs the cheapest of chcpp, vfc and nohc for this view, learnt from the measured frame times, "
         "with hysteresis",
         true,
-        {{"candidates", "vfc+chcpp+nohc", "cullers to choose among, joined by + (nohc only with a profile, which occull bench passes)"},
+        {{"candidates", "chcpp+vfc+nohc", "cullers to choose among, joined by +, tried in this order (nohc only with a profile, which occull bench passes)"},
          {"trial", "2", "frames a candidate runs when tried (its cost: their median, per unit of frame content)"},
          {"period", "50", "frames between tries of a challenger (doubled after each lost try, up to 16x)"},
          {"margin", "0.05", "a challenger must be this much cheaper to take over"}}},
