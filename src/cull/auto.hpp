@@ -14,7 +14,7 @@ struct AutoConfig {
   std::vector<std::string> candidates{"chcpp", "vfc", "nohc"};
   int trial = 2;          ///< frames a candidate runs when tried (its cost: their median)
   int period = 50;        ///< frames between tries of a challenger
-  double margin = 0.05;   ///< a challenger must be this much cheaper to take over (hysteresis)
+  double margin = 0.15;   ///< a challenger must be this much cheaper to take over (hysteresis)
   double smoothing = 0.15;  ///< weight of the newest frame in the running cost of the current culler
 };
 

@@ -80,7 +80,7 @@ const std::vector<Entry>& registry() {
         {{"candidates", "chcpp+vfc+nohc", "cullers to choose among, joined by +, tried in this order (nohc only with a profile, which occull bench passes)"},
          {"trial", "2", "frames a candidate runs when tried (its cost: their median, per unit of frame content)"},
          {"period", "50", "frames between tries of a challenger (doubled after each lost try, up to 16x)"},
-         {"margin", "0.05", "a challenger must be this much cheaper to take over"}}},
+         {"margin", "0.15", "a challenger must be this much cheaper to take over (frame times of one culler vary more than 5 % between frames)"}}},
        &detail::make_auto},
       {{"oracle",
         "renders exactly the ground-truth visible set, no queries: the lower bound (occull bench only)",
