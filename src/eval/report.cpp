@@ -16,7 +16,6 @@
 namespace occull {
 namespace {
 
-std::string ratio_text(double r) { return r > 0 ? fmt::format("{:.2f}", r) : "-"; }
 
 // Per frame, the median over repeats of one figure of one algorithm.
 std::vector<double> per_frame_median(const BenchResult& r, const std::string& name,
@@ -122,7 +121,7 @@ void print_table(const BenchResult& r, std::ostream& out) {
         "{:<{}} {:>8.2f} {:>8.2f} {:>8.2f} {:>8.2f} {:>6} {:>7} {:>8.1f} {:>7.1f} {:>7.0f} {:>10.0f} "
         "{:>7} {:>9}\n",
         a.name, w, a.frame_ms.mean, a.frame_ms.median, a.frame_ms.p95, a.frame_ms.max,
-        ratio_text(a.ratio_to_vfc), ratio_text(a.ratio_to_oracle), a.queries_per_frame,
+        detail::ratio_text(a.ratio_to_vfc), detail::ratio_text(a.ratio_to_oracle), a.queries_per_frame,
         a.state_changes_per_frame, a.draw_calls_per_frame, a.triangles_per_frame,
         misses_text(r, a.missed_objects), misses_text(r, a.wrong_pixels));
   }
@@ -229,6 +228,8 @@ nlohmann::ordered_json detail::bench_json(const BenchResult& r) {
   return doc;
 }
 
+std::string detail::ratio_text(double r) { return r > 0 ? fmt::format("{:.2f}", r) : "-"; }
+
 void write_json(const BenchResult& r, std::ostream& out) { out << detail::bench_json(r).dump(2) << "\n"; }
 
 void write_csv(const BenchResult& r, std::ostream& out) {
@@ -314,7 +315,7 @@ std::vector<std::string> write_report(const BenchResult& r, const std::string& d
     md += fmt::format("| {} | {:.2f} | {:.2f} | {:.2f} | {:.2f} | {} | {} | {:.1f} | {:.1f} | {:.0f} | {:.0f} | "
                       "{} | {} | {} | {} | {:.1f} | {:.3f} | {:.3f} | {:.3f} | {:.0f} | {:.2f} |\n",
                       a.name, a.frame_ms.mean, a.frame_ms.median, a.frame_ms.p95, a.frame_ms.max,
-                      ratio_text(a.ratio_to_vfc), ratio_text(a.ratio_to_oracle), a.queries_per_frame,
+                      detail::ratio_text(a.ratio_to_vfc), detail::ratio_text(a.ratio_to_oracle), a.queries_per_frame,
                       a.state_changes_per_frame, a.draw_calls_per_frame, a.triangles_per_frame,
                       misses_text(r, a.missed_objects), misses_text(r, a.frames_with_misses),
                       misses_text(r, a.wrong_pixels), misses_text(r, a.longest_miss_frames),

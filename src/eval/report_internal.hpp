@@ -11,6 +11,9 @@ namespace occull::detail {
 
 [[nodiscard]] nlohmann::ordered_json bench_json(const BenchResult& result);
 
+/// A ratio with two decimals, or "-" when it is 0 (its baseline did not run).
+[[nodiscard]] std::string ratio_text(double ratio);
+
 /// Writes `text` to dir/name and returns that path. Throws InputError when it cannot.
 std::string write_report_file(const std::string& dir, const std::string& name, const std::string& text);
 

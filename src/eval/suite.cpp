@@ -26,8 +26,6 @@ const AlgorithmSummary* find(const BenchResult& r, const std::string& name) {
   return nullptr;
 }
 
-std::string ratio_text(double r) { return r > 0 ? fmt::format("{:.2f}", r) : "-"; }
-
 }  // namespace
 
 std::span<const Suite> suites() {
@@ -114,8 +112,8 @@ void print_suite_summary(const Suite& suite, std::span<const BenchResult> result
                      "geomean/vfc", "worst/vfc", "geomean/oracle", "worst/orc", "missed", "worst vs vfc in");
   for (const SuiteRow& row : rows)
     out << fmt::format("{:<{}} {:>6} {:>11} {:>9} {:>14} {:>9} {:>7}  {}\n", row.algorithm, w, row.scenes,
-                       ratio_text(row.geomean_to_vfc), ratio_text(row.worst_to_vfc),
-                       ratio_text(row.geomean_to_oracle), ratio_text(row.worst_to_oracle), row.missed_objects,
+                       detail::ratio_text(row.geomean_to_vfc), detail::ratio_text(row.worst_to_vfc),
+                       detail::ratio_text(row.geomean_to_oracle), detail::ratio_text(row.worst_to_oracle), row.missed_objects,
                        row.worst_to_vfc_entry.empty() ? "-" : row.worst_to_vfc_entry);
   out << "\nratios: each entry's mean frame time over vfc's / the oracle's in the same run; geomean: their "
          "geometric mean over the entries; worst: the largest. missed: visible objects culled, summed over "

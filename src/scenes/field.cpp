@@ -71,13 +71,6 @@ Mesh rock_mesh(Rng& rng) {
   return m;
 }
 
-CameraPath::Key look_at_key(double t, glm::vec3 eye, glm::vec3 target) {
-  const glm::vec3 d = target - eye;
-  const float yaw = std::atan2(-d.x, -d.z);
-  const float pitch = std::atan2(d.y, std::sqrt(d.x * d.x + d.z * d.z));
-  return {t, {eye, yaw, pitch}, false};
-}
-
 }  // namespace
 
 SceneInfo field_info() {

@@ -109,4 +109,11 @@ void MeshBuilder::gable(const Aabb& f, float ridge_height, bool along_x) {
   }
 }
 
+CameraPath::Key look_at_key(double t, const glm::vec3& eye, const glm::vec3& target) {
+  const glm::vec3 d = target - eye;
+  const float yaw = std::atan2(-d.x, -d.z);
+  const float pitch = std::atan2(d.y, std::sqrt(d.x * d.x + d.z * d.z));
+  return {t, {eye, yaw, pitch}, false};
+}
+
 }  // namespace occull::scenes

@@ -3,6 +3,7 @@
 #pragma once
 
 #include "occull/scene.hpp"
+#include "occull/view.hpp"
 
 #include <cstdint>
 
@@ -66,5 +67,8 @@ class MeshBuilder {
  private:
   Mesh mesh_;
 };
+
+/// A camera-path key at time `t` (seconds): the eye at `eye`, looking at `target`.
+CameraPath::Key look_at_key(double t, const glm::vec3& eye, const glm::vec3& target);
 
 }  // namespace occull::scenes

@@ -222,9 +222,7 @@ SceneBundle make_track(const Params& params) {
     for (int k = 0; k <= 12; ++k) {
       const float a = glm::two_pi<float>() * float(k) / 12.0f * 0.75f;
       const glm::vec3 eye(1.1f * radius * std::cos(a), 0.35f * radius, 1.1f * radius * std::sin(a));
-      const glm::vec3 d = -eye;
-      keys.push_back({3.0 * k, {eye, std::atan2(-d.x, -d.z), std::atan2(d.y, std::sqrt(d.x * d.x + d.z * d.z))},
-                      false});
+      keys.push_back(look_at_key(3.0 * k, eye, glm::vec3(0.0f)));
     }
     bundle.paths.emplace_back("overview", "circles high above the track looking down at its centre",
                               std::move(keys));
