@@ -287,3 +287,69 @@ TEST(Chcpp, BatchingCutsStateChangesComparedWithChc) {
   }
   EXPECT_LT(changes["chcpp"] * 10, changes["chc"]);
 }
+
+TEST(EnteringGate, QueriesUntilEnteringNodesProveRarelyOccludedPerRegion) {
+  EnteringGate gate(2, 0.1);
+  EXPECT_TRUE(gate.query(0)) << "a new scene starts as plain CHC++";
+  for (int i = 0; i < 100; ++i) gate.record(0, false);  // region 0: open ground
+  for (int i = 0; i < 100; ++i) gate.record(1, i % 2 == 0);  // region 1: half occluded
+  EXPECT_FALSE(gate.query(0));
+  EXPECT_LT(gate.p_occluded(0), 0.1);
+  EXPECT_TRUE(gate.query(1)) << "the other subtree keeps querying";
+  EXPECT_NEAR(gate.p_occluded(1), 0.5, 0.15);
+  for (int i = 0; i < 40; ++i) gate.record(0, true);  // walls come into view
+  EXPECT_TRUE(gate.query(0)) << "recent outcomes weigh most";
+  EnteringGate always(1, 0.0);
+  for (int i = 0; i < 100; ++i) always.record(0, false);
+  EXPECT_TRUE(always.query(0)) << "p_min 0: always query, as CHC++";
+}
+
+namespace {
+
+// 48 boxes on a ring around the camera, which turns 0.15 rad a frame, so
+// nodes keep entering the view. Returns the queries of frames 60..119 and
+// checks every frame draws each box in the frustum that the backend calls visible.
+std::uint64_t queries_while_turning(const char* enter_p_min, bool all_visible) {
+  std::vector<Aabb> boxes;
+  for (int i = 0; i < 48; ++i) {
+    const float a = float(i) * 6.2831853f / 48.0f;
+    const glm::vec3 c{20.0f * std::cos(a), 0.0f, 20.0f * std::sin(a)};
+    boxes.push_back({c - glm::vec3(0.5f), c + glm::vec3(0.5f)});
+  }
+  const Scene scene = test::box_scene(boxes);
+  const Bvh bvh = Bvh::build(scene);
+  Options o;
+  o.set("chcpp.virtual_leaf", "0");
+  o.set("chcpp.enter_p_min", enter_p_min);
+  auto culler = make_culler("chcpp", {scene, bvh}, o);
+  test::RecordingBackend backend;
+  if (!all_visible) backend.visible_samples = [](std::span<const Aabb>) { return std::uint64_t(0); };
+  std::uint64_t queries = 0;
+  for (int f = 0; f < 120; ++f) {
+    const View view = make_view({{0, 0, 0}, 0.15f * float(f), 0}, {60.0f, 0.1f, 100.0f}, 64, 64);
+    backend.rendered.clear();
+    const std::uint64_t before = backend.stats().queries;
+    (void)culler->render_frame(view, backend);
+    if (f >= 60) queries += backend.stats().queries - before;
+    if (!all_visible) continue;
+    const std::set<ObjectId> drawn(backend.rendered.begin(), backend.rendered.end());
+    for (ObjectId i = 0; i < boxes.size(); ++i)
+      if (view.frustum.classify(boxes[i]) != Containment::outside) {
+        EXPECT_TRUE(drawn.count(i)) << "visible box " << i << " not drawn in frame " << f;
+      }
+  }
+  return queries;
+}
+
+}  // namespace
+
+TEST(Chcpp, StopsQueryingNodesEnteringTheViewWhereNoneTurnsOutOccluded) {
+  const std::uint64_t chcpp = queries_while_turning("0", true);
+  const std::uint64_t gated = queries_while_turning("0.1", true);
+  EXPECT_GT(chcpp, 60u);
+  EXPECT_LT(gated * 2, chcpp) << "entering nodes are drawn without queries once none was occluded";
+}
+
+TEST(Chcpp, KeepsQueryingNodesEnteringTheViewWhereTheyTurnOutOccluded) {
+  EXPECT_EQ(queries_while_turning("0.1", false), queries_while_turning("0", false));
+}

@@ -69,6 +69,29 @@ std::size_t best_multiquery_size(std::span<const double> p_keep_sorted) {
   return best;
 }
 
+void EnteringGate::add(Counts& c, bool occluded, double window) {
+  if (c.tests >= window) {  // forget slowly: older outcomes weigh half
+    c.tests *= 0.5;
+    c.occluded *= 0.5;
+  }
+  c.tests += 1.0;
+  if (occluded) c.occluded += 1.0;
+}
+
+void EnteringGate::record(std::size_t region, bool occluded) {
+  add(regions_.at(region), occluded, 32.0);
+  add(global_, occluded, 256.0);
+}
+
+double EnteringGate::p_occluded(std::size_t region) const {
+  // The region's own share, pulled toward the global one by 4 outcomes'
+  // worth: a region with few outcomes follows the scene as a whole.
+  constexpr double kPull = 4.0;
+  const Counts& r = regions_.at(region);
+  const double global = global_.occluded / global_.tests;
+  return (r.occluded + kPull * global) / (r.tests + kPull);
+}
+
 std::uint32_t first_requery_delay(std::uint32_t n_av, std::uint64_t random) {
   if (n_av <= 1) return n_av;
   return 1 + std::uint32_t(random % (n_av - 1));  // 0 < r < n_av
@@ -93,6 +116,9 @@ ChcppConfig read_config(const Options& o) {
   c.render_batch_triangles =
       std::uint64_t(o.get_int("chcpp.render_batch", int(c.render_batch_triangles), 0, 1 << 30));
   c.seed = std::uint64_t(o.get_int("chcpp.seed", int(c.seed), 0, 1 << 30));
+  c.enter_p_min = o.get_double("chcpp.enter_p_min", c.enter_p_min, 0.0, 1.0);
+  c.backoff = std::uint32_t(o.get_int("chcpp.backoff", int(c.backoff), 0, 10));
+  c.gate_depth = o.get_int("chcpp.gate_depth", c.gate_depth, 0, 30);
   return c;
 }
 
@@ -108,11 +134,14 @@ class ChcppCuller final : public Culler {
  public:
   ChcppCuller(const SceneIndex& index, const ChcppConfig& config)
       : index_(index), config_(config), persistence_(config.pkeep_min_samples),
-        state_(index.bvh.size()), random_(config.seed) {}
+        state_(index.bvh.size()), random_(config.seed), gate_(assign_regions(), config.enter_p_min) {}
 
   FrameStats render_frame(const View& view, Backend& backend) override {
     ++frame_;
-    if (state_.size() != index_.bvh.size()) state_.assign(index_.bvh.size(), NodeState{});
+    if (state_.size() != index_.bvh.size()) {
+      state_.assign(index_.bvh.size(), NodeState{});
+      gate_ = EnteringGate(assign_regions(), config_.enter_p_min);
+    }
     f_.begin(view, backend);
     frustum_.begin(index_.bvh, view);
     query_nodes_.clear();
@@ -162,6 +191,31 @@ class ChcppCuller final : public Culler {
   // A real leaf, or a virtual one: few triangles and few objects (a subtree
   // of many small meshes spread far apart is no leaf: queried as one it is
   // almost always visible and culls nothing).
+  // Per-node flags besides NodeState.
+  static constexpr std::uint8_t kOccluded = 1;  // its last test found it occluded
+  static constexpr std::uint8_t kEntering = 2;  // queried as an entering node: its answer teaches the gate
+  static constexpr std::uint8_t kProbe = 4;     // drawn on entering without a query: so does its first re-query
+
+  // The gate's region of every node: the subtree rooted at depth
+  // gate_depth it lies in (nodes above that depth are regions of their own).
+  // Returns the number of regions.
+  std::size_t assign_regions() {
+    const Bvh& bvh = index_.bvh;
+    region_.assign(bvh.size(), 0);
+    flags_.assign(bvh.size(), 0);
+    visible_streak_.assign(bvh.size(), 0);
+    std::uint32_t regions = 0;
+    for (NodeId n = 0; n < NodeId(bvh.size()); ++n) {  // parents come before their children
+      const BvhNode& node = bvh.node(n);
+      region_[n] = node.parent == kNoNode || node.depth <= config_.gate_depth ? regions++ : region_[node.parent];
+    }
+    return regions;
+  }
+
+  std::uint32_t requery_delay() {
+    return config_.jitter ? first_requery_delay(config_.n_av, next_random(random_)) : config_.n_av;
+  }
+
   bool is_leaf(NodeId n) const {
     const BvhNode& node = index_.bvh.node(n);
     return node.is_leaf() || (node.triangles <= config_.common.virtual_leaf_triangles &&
@@ -172,6 +226,9 @@ class ChcppCuller final : public Culler {
     ++f_.stats.nodes_visited;
     NodeState& s = state_[n];
     const bool previously_visible = was_visible(s, frame_);
+    const bool previously_occluded =
+        s.last_visited != kNever && s.last_visited + 1 == frame_ && (flags_[n] & kOccluded) != 0;
+    flags_[n] &= std::uint8_t(~(kOccluded | kEntering));
     s.visible = false;  // invisible by default
     s.last_visited = frame_;
     if (previously_visible) s.invisible_tests = 0;  // if invisible now, its persistence starts over
@@ -183,6 +240,18 @@ class ChcppCuller final : public Culler {
       return;
     }
     if (!previously_visible) {
+      if (!previously_occluded) {
+        if (!gate_.query(region_[n])) {  // entering where queries do not pay: draw it
+          if (is_leaf(n)) {
+            flags_[n] |= kProbe;
+            s.next_query = frame_ + requery_delay();
+            pull_up_visibility(state_, index_.bvh, n);
+          }
+          traverse(n);
+          return;
+        }
+        flags_[n] |= kEntering;
+      }
       i_queue_.push_back({n, false});
       if (i_queue_.size() >= config_.batch) issue_multiqueries();
       return;
@@ -285,10 +354,19 @@ class ChcppCuller final : public Culler {
     const std::span<const NodeId> nodes(query_nodes_.data() + q.first, q.count);
     if (q.previously_visible) {  // a v-queue query: classification for the next frame
       const NodeId n = nodes.front();
+      if (flags_[n] & kProbe) {
+        gate_.record(region_[n], !visible);
+        flags_[n] &= std::uint8_t(~kProbe);
+      }
+      if (!visible) flags_[n] |= kOccluded;
       if (visible) {
         pull_up_visibility(state_, index_.bvh, n);
-        state_[n].next_query = frame_ + config_.n_av;
+        // Found visible again: wait longer before the next query.
+        const std::uint32_t streak = std::min<std::uint32_t>(visible_streak_[n]++, config_.backoff);
+        visible_streak_[n] = std::min<std::uint8_t>(visible_streak_[n], 31);
+        state_[n].next_query = frame_ + (config_.n_av << streak);
       } else {
+        visible_streak_[n] = 0;
         state_[n].invisible_tests = 0;  // newly invisible
       }
       return;
@@ -301,16 +379,20 @@ class ChcppCuller final : public Culler {
     for (NodeId n : nodes) {
       NodeState& s = state_[n];
       persistence_.record(s.invisible_tests, !visible);
+      if (flags_[n] & kEntering) gate_.record(region_[n], !visible);
+      flags_[n] &= std::uint8_t(~kEntering);
       if (!visible) {
         ++s.invisible_tests;
+        flags_[n] |= kOccluded;
         continue;
       }
       s.invisible_tests = 0;
       traverse(n);  // turned visible: process it now
       pull_up_visibility(state_, index_.bvh, n);
-      if (is_leaf(n))
-        s.next_query = frame_ + (config_.jitter ? first_requery_delay(config_.n_av, next_random(random_))
-                                                : config_.n_av);
+      if (is_leaf(n)) {
+        s.next_query = frame_ + requery_delay();
+        visible_streak_[n] = 0;
+      }
     }
   }
 
@@ -320,6 +402,10 @@ class ChcppCuller final : public Culler {
   std::vector<NodeState> state_;
   std::uint32_t frame_ = 0;
   std::uint64_t random_;
+  std::vector<std::uint32_t> region_;  // the gate's region of each node
+  std::vector<std::uint8_t> flags_;    // kOccluded | kEntering | kProbe
+  std::vector<std::uint8_t> visible_streak_;  // re-queries of a visible leaf in a row that found it visible
+  EnteringGate gate_;
 
   // Per frame.
   FrameContext f_;

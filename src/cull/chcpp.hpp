@@ -8,6 +8,7 @@
 #include <array>
 #include <cstdint>
 #include <span>
+#include <vector>
 
 namespace occull::detail {
 
@@ -24,6 +25,42 @@ struct ChcppConfig {
   std::uint64_t seed = 1;                ///< of the jitter
   bool flush_batches = true;             ///< Backend::flush() after each query batch
   std::uint64_t render_batch_triangles = 20000;  ///< hand the render queue over at this size (0: only before queries)
+  double enter_p_min = 0.1;   ///< query entering nodes where at least this share of them is found occluded (0: always)
+  std::uint32_t backoff = 2;  ///< a leaf found visible k times in a row waits n_av * 2^min(k-1, backoff) frames
+  int gate_depth = 5;         ///< the entering statistics are kept per subtree rooted at this BVH depth
+};
+
+/// Whether queries of *entering* nodes pay: nodes that were not found
+/// occluded in the previous frame and were not visible either (outside the
+/// frustum, or not reached). CHC queries every one; where few of them turn
+/// out occluded (open ground, small maps) those queries, their waits and the
+/// cascade down the hierarchy of nodes that come back visible only cost.
+/// The gate learns, per subtree (region) of the BVH, the share of entering
+/// nodes found occluded — from the queries of entering nodes, and from the
+/// first re-query of a leaf that was drawn without one — and says to query
+/// where that share is at least p_min. Recent outcomes weigh most (counts
+/// are halved as they grow); a region with few outcomes leans on the global
+/// share, which starts at 1/2 so a new scene begins with plain CHC++.
+class EnteringGate {
+ public:
+  /// `regions`: how many subtrees keep their own counts; `p_min` 0 always queries.
+  EnteringGate(std::size_t regions, double p_min) : regions_(regions), p_min_(p_min) {}
+  /// An entering node of `region` was found occluded (or not).
+  void record(std::size_t region, bool occluded);
+  /// The estimated share of entering nodes of `region` found occluded.
+  [[nodiscard]] double p_occluded(std::size_t region) const;
+  /// Whether an entering node of `region` should be queried.
+  [[nodiscard]] bool query(std::size_t region) const { return p_min_ <= 0.0 || p_occluded(region) >= p_min_; }
+
+ private:
+  struct Counts {
+    double occluded = 0.0;
+    double tests = 0.0;
+  };
+  static void add(Counts& c, bool occluded, double window);
+  std::vector<Counts> regions_;
+  Counts global_{4.0, 8.0};  // prior: 1/2, worth 8 outcomes
+  double p_min_;
 };
 
 /// p_keep(i): the probability that a node found invisible in i consecutive
