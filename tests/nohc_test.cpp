@@ -254,3 +254,18 @@ TEST(Profile, SaveReplacesTheFileAndLeavesNoTemporaryBehind) {
   EXPECT_EQ(files, 1u);
   EXPECT_THROW(save_profile(p, "/proc/occull/p.json"), InputError);
 }
+
+TEST(OcclusionCalibration, ScalesTheModelByWhatTheQueriesFound) {
+  OcclusionCalibration c;
+  EXPECT_DOUBLE_EQ(c.ratio(PreviousState::outside), 1.0) << "the model alone until there are outcomes";
+  for (int i = 0; i < 300; ++i) c.record(PreviousState::outside, 0.5, i % 10 == 0);  // 10% found occluded
+  EXPECT_NEAR(c.ratio(PreviousState::outside), 0.2, 0.03);
+  EXPECT_NEAR(c.scale(PreviousState::outside, 0.5), 0.1, 0.015);
+  EXPECT_DOUBLE_EQ(c.ratio(PreviousState::visible), 1.0) << "each previous state on its own";
+  for (int i = 0; i < 300; ++i) c.record(PreviousState::visible, 0.1, true);  // the model underrates
+  EXPECT_DOUBLE_EQ(c.ratio(PreviousState::visible), 4.0) << "at most 4x";
+  EXPECT_DOUBLE_EQ(c.scale(PreviousState::visible, 0.5), 1.0) << "a probability stays within [0, 1]";
+  for (int i = 0; i < 300; ++i) c.record(PreviousState::outside, 0.5, false);
+  EXPECT_DOUBLE_EQ(c.ratio(PreviousState::outside), 1.0 / 16.0) << "never below 1/16";
+  EXPECT_DOUBLE_EQ(c.scale(PreviousState::occluded, 1.0), 1.0) << "an occluded node stays certain";
+}

@@ -73,6 +73,7 @@ const std::vector<Entry>& registry() {
          {"levels", "0", "levels the benefit is spread over (0: log2(N_h + 1))"},
          {"max_parallel", "0", "N_q: queries in flight before the oldest counts as finished (0: from the profile)"},
          {"exact_area", "on", "c_bb from the exact projected box area (off: the paper's approximation)"},
+         {"learn", "on", "correct the occlusion probabilities by the share of queries that found nodes occluded, per previous state (off: the paper's model alone)"},
          {"flush_every", "8", "hand queries to the device this many at a time, and poll only those handed over (1: each at once)"},
          {"virtual_leaf", "0", "subtrees with at most this many triangles count as leaves (0: off)"}}},
        &detail::make_nohc},

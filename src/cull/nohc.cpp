@@ -57,6 +57,28 @@ bool query_reasonable(const ReasonabilityInput& in) {
          in.query_overhead_ms * double(n.leaves) > n.t_o;
 }
 
+void OcclusionCalibration::record(PreviousState previous, double predicted, bool occluded) {
+  Sums& s = sums_[std::size_t(previous)];
+  if (s.queries >= 256.0) {
+    s.predicted *= 0.5;
+    s.occluded *= 0.5;
+    s.queries *= 0.5;
+  }
+  s.predicted += predicted;
+  s.occluded += occluded ? 1.0 : 0.0;
+  s.queries += 1.0;
+}
+
+double OcclusionCalibration::ratio(PreviousState previous) const {
+  if (previous == PreviousState::occluded) return 1.0;
+  const Sums& s = sums_[std::size_t(previous)];
+  return std::clamp(s.occluded / std::max(s.predicted, 1e-9), 1.0 / 16.0, 4.0);
+}
+
+double OcclusionCalibration::scale(PreviousState previous, double p) const {
+  return std::clamp(p * ratio(previous), 0.0, 1.0);
+}
+
 namespace {
 
 struct NohcConfig {
@@ -68,6 +90,7 @@ struct NohcConfig {
   bool exact_area = true;        // projected box area instead of the paper's approximation
   std::uint32_t virtual_leaf = 0;
   std::uint32_t flush_every = 8;  // queries handed to the device together
+  bool learn = true;              // correct p_occl by the measured outcomes (OcclusionCalibration)
 };
 
 class NohcCuller final : public Culler {
@@ -134,6 +157,8 @@ class NohcCuller final : public Culler {
     QueryId id;
     NodeId node;
     bool wait;  // children held back until the answer
+    PreviousState previous;  // of the node when queried, and the model's p_occl for it (uncorrected)
+    double p_occl;
     std::uint32_t submission;  // QuerySubmitter tag: polled only once handed to the device
   };
 
@@ -196,9 +221,11 @@ class NohcCuller final : public Culler {
     NodeEstimate e;
     e.t_r = render_time(hw_, cost, f_.view->width, f_.view->height, config_.fragments_per_pixel);
     e.t_o = query_time(hw_, cost.c_bb, f_.view->width, f_.view->height);
-    double p = occlusion_probability(previous_state(n), coverage_probability(c_scr_, cost.c_bb));
-    if (previous_state(n) == PreviousState::visible) p *= config_.visible_factor / 0.5;
-    e.p_occl = std::clamp(p, 0.0, 1.0);
+    const PreviousState previous = previous_state(n);
+    double p = occlusion_probability(previous, coverage_probability(c_scr_, cost.c_bb));
+    if (previous == PreviousState::visible) p *= config_.visible_factor / 0.5;
+    model_p_occl_ = std::clamp(p, 0.0, 1.0);
+    e.p_occl = config_.learn ? calibration_.scale(previous, p) : model_p_occl_;
     e.leaves = node.object_count;
     return e;
   }
@@ -219,6 +246,7 @@ class NohcCuller final : public Culler {
     }
     ReasonabilityInput in;
     in.node = estimate(n);
+    const double model_p_occl = model_p_occl_;  // before the children's estimates replace it
     NodeEstimate kids[2];
     if (!is_leaf(n)) {
       kids[0] = child_estimate(Bvh::left(n));
@@ -235,7 +263,7 @@ class NohcCuller final : public Culler {
       append_query_boxes(index_, n, {}, boxes_);
       const bool wait = previous == PreviousState::occluded;
       const QueryId q = f_.backend->issue_query(boxes_);
-      query_queue_.push_back({q, n, wait, submitter_.issued(*f_.backend)});
+      query_queue_.push_back({q, n, wait, previous, model_p_occl, submitter_.issued(*f_.backend)});
       ++f_.stats.query_batches;
       info.frames_since_query = 0;
       if (!wait) process(n);
@@ -286,6 +314,7 @@ class NohcCuller final : public Culler {
     const Pending q = query_queue_.front();
     query_queue_.pop_front();
     const bool visible = f_.backend->result(q.id) > config_.threshold;
+    calibration_.record(q.previous, q.p_occl, !visible);
     if (cancelled(q.node)) return;  // an ancestor is occluded: nothing to do
     NodeInfo& info = nodes_[q.node];
     if (visible) {
@@ -317,12 +346,14 @@ class NohcCuller final : public Culler {
   FrustumCache frustum_;
   double fov_y_ = 1.0;
   double c_scr_ = 0.0;
+  double model_p_occl_ = 0.0;  // the model's p_occl of the last estimate, before calibration
   DistanceQueue distance_queue_;
   std::deque<Pending> query_queue_;
   std::vector<ObjectId> render_queue_;
   std::vector<Aabb> boxes_;
   std::vector<NodeId> cancel_stack_;
   QuerySubmitter submitter_;
+  OcclusionCalibration calibration_;
 };
 
 }  // namespace
@@ -337,6 +368,7 @@ std::unique_ptr<Culler> make_nohc(const SceneIndex& index, const Options& o) {
   c.exact_area = o.get_bool("nohc.exact_area", c.exact_area);
   c.virtual_leaf = std::uint32_t(o.get_int("nohc.virtual_leaf", 0, 0, 1 << 30));
   c.flush_every = std::uint32_t(o.get_int("nohc.flush_every", int(c.flush_every), 1, 1 << 20));
+  c.learn = o.get_bool("nohc.learn", c.learn);
   const auto it = o.values().find("nohc.profile");
   if (it == o.values().end() || it->second.empty())
     throw InputError("nohc needs a hardware profile: run `occull calibrate` (occull bench does it "

@@ -42,4 +42,30 @@ struct ReasonabilityInput {
 ///    rendering (T_o^o N_l) would cost more than this one query.
 [[nodiscard]] bool query_reasonable(const ReasonabilityInput& in);
 
+/// The occlusion probabilities of the model against what the queries found.
+/// Per previous state (visible, outside; an occluded node's p_occl is 1 by
+/// definition), it sums the predicted p_occl of the queried nodes and counts
+/// those found occluded; scale() multiplies a prediction by their ratio.
+/// Where the model overrates occlusion (open ground: coverage says a node
+/// may be hidden, the query finds it visible) its queries stop paying and
+/// the ratio falls, so fewer queries pass query_reasonable; where it
+/// underrates it, more do. Older outcomes weigh less (sums halve past 256
+/// queries); two queries' worth of prior keep the ratio at 1 until there
+/// are outcomes, and it stays within [1/16, 4].
+class OcclusionCalibration {
+ public:
+  void record(PreviousState previous, double predicted, bool occluded);
+  [[nodiscard]] double ratio(PreviousState previous) const;
+  /// `p` corrected by ratio(previous), within [0, 1].
+  [[nodiscard]] double scale(PreviousState previous, double p) const;
+
+ private:
+  struct Sums {
+    double predicted = 1.0;  // prior: two queries at p = 1/2, one of them occluded
+    double occluded = 1.0;
+    double queries = 2.0;
+  };
+  Sums sums_[3];
+};
+
 }  // namespace occull::detail
