@@ -134,13 +134,13 @@ class ChcppCuller final : public Culler {
  public:
   ChcppCuller(const SceneIndex& index, const ChcppConfig& config)
       : index_(index), config_(config), persistence_(config.pkeep_min_samples),
-        state_(index.bvh.size()), random_(config.seed), gate_(assign_regions(), config.enter_p_min) {}
+        state_(index.bvh.size()), random_(config.seed), gate_(reset_nodes(), config.enter_p_min) {}
 
   FrameStats render_frame(const View& view, Backend& backend) override {
     ++frame_;
     if (state_.size() != index_.bvh.size()) {
       state_.assign(index_.bvh.size(), NodeState{});
-      gate_ = EnteringGate(assign_regions(), config_.enter_p_min);
+      gate_ = EnteringGate(reset_nodes(), config_.enter_p_min);
     }
     f_.begin(view, backend);
     frustum_.begin(index_.bvh, view);
@@ -188,18 +188,15 @@ class ChcppCuller final : public Culler {
     bool single;  // re-queried alone after a failed multiquery
   };
 
-  // A real leaf, or a virtual one: few triangles and few objects (a subtree
-  // of many small meshes spread far apart is no leaf: queried as one it is
-  // almost always visible and culls nothing).
   // Per-node flags besides NodeState.
   static constexpr std::uint8_t kOccluded = 1;  // its last test found it occluded
   static constexpr std::uint8_t kEntering = 2;  // queried as an entering node: its answer teaches the gate
   static constexpr std::uint8_t kProbe = 4;     // drawn on entering without a query: so does its first re-query
 
-  // The gate's region of every node: the subtree rooted at depth
-  // gate_depth it lies in (nodes above that depth are regions of their own).
-  // Returns the number of regions.
-  std::size_t assign_regions() {
+  // Sizes and clears the per-node data besides NodeState, and gives every
+  // node its gate region: the subtree rooted at depth gate_depth it lies in
+  // (nodes above that depth are regions of their own). Returns the number of regions.
+  std::size_t reset_nodes() {
     const Bvh& bvh = index_.bvh;
     region_.assign(bvh.size(), 0);
     flags_.assign(bvh.size(), 0);
@@ -216,6 +213,9 @@ class ChcppCuller final : public Culler {
     return config_.jitter ? first_requery_delay(config_.n_av, next_random(random_)) : config_.n_av;
   }
 
+  // A real leaf, or a virtual one: few triangles and few objects (a subtree
+  // of many small meshes spread far apart is no leaf: queried as one it is
+  // almost always visible and culls nothing).
   bool is_leaf(NodeId n) const {
     const BvhNode& node = index_.bvh.node(n);
     return node.is_leaf() || (node.triangles <= config_.common.virtual_leaf_triangles &&
@@ -358,14 +358,14 @@ class ChcppCuller final : public Culler {
         gate_.record(region_[n], !visible);
         flags_[n] &= std::uint8_t(~kProbe);
       }
-      if (!visible) flags_[n] |= kOccluded;
       if (visible) {
         pull_up_visibility(state_, index_.bvh, n);
         // Found visible again: wait longer before the next query.
-        const std::uint32_t streak = std::min<std::uint32_t>(visible_streak_[n]++, config_.backoff);
-        visible_streak_[n] = std::min<std::uint8_t>(visible_streak_[n], 31);
+        const std::uint32_t streak = std::min<std::uint32_t>(visible_streak_[n], config_.backoff);
+        if (visible_streak_[n] < 31) ++visible_streak_[n];
         state_[n].next_query = frame_ + (config_.n_av << streak);
       } else {
+        flags_[n] |= kOccluded;
         visible_streak_[n] = 0;
         state_[n].invisible_tests = 0;  // newly invisible
       }
