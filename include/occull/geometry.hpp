@@ -133,6 +133,12 @@ class Frustum {
 [[nodiscard]] double projected_area(const Aabb& b, const glm::mat4& view_proj, int width,
                                     int height) noexcept;
 
+/// Convex hull of `points` (Andrew's monotone chain), counter-clockwise,
+/// without collinear points, into `out`; returns how many it wrote. Sorts
+/// `points` in place. Fewer than 3 points (or all on a line) give at most 2.
+/// Precondition: `out` has room for 2 * points.size() points.
+std::size_t convex_hull(std::span<glm::dvec2> points, glm::dvec2* out) noexcept;
+
 /// Area of a convex polygon given in order (either winding), by the shoelace
 /// formula. Units: those of the points squared.
 [[nodiscard]] double polygon_area(std::span<const glm::dvec2> points) noexcept;

@@ -88,6 +88,29 @@ double polygon_area(std::span<const glm::dvec2> pts) noexcept {
   return std::abs(twice) * 0.5;
 }
 
+std::size_t convex_hull(std::span<glm::dvec2> pts, glm::dvec2* out) noexcept {
+  const auto cross = [](const glm::dvec2& o, const glm::dvec2& a, const glm::dvec2& b) {
+    return (a.x - o.x) * (b.y - o.y) - (a.y - o.y) * (b.x - o.x);
+  };
+  std::sort(pts.begin(), pts.end(),
+            [](const glm::dvec2& a, const glm::dvec2& b) { return a.x < b.x || (a.x == b.x && a.y < b.y); });
+  const std::size_t n = pts.size();
+  if (n < 3) {
+    std::copy(pts.begin(), pts.end(), out);
+    return n;
+  }
+  std::size_t k = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    while (k >= 2 && cross(out[k - 2], out[k - 1], pts[i]) <= 0) --k;
+    out[k++] = pts[i];
+  }
+  for (std::size_t i = n - 1, lower = k + 1; i-- > 0;) {
+    while (k >= lower && cross(out[k - 2], out[k - 1], pts[i]) <= 0) --k;
+    out[k++] = pts[i];
+  }
+  return k - 1;  // the last point repeats the first
+}
+
 namespace {
 
 // At most 8 corners plus 12 near-plane crossings; each of the four screen
@@ -101,27 +124,11 @@ struct Polygon {
   }
 };
 
-double cross(const glm::dvec2& o, const glm::dvec2& a, const glm::dvec2& b) noexcept {
-  return (a.x - o.x) * (b.y - o.y) - (a.y - o.y) * (b.x - o.x);
-}
-
-// Andrew's monotone chain, in place of `pts`; the hull counter-clockwise.
 Polygon convex_hull(Polygon pts) noexcept {
-  std::sort(pts.p.begin(), pts.p.begin() + std::ptrdiff_t(pts.n),
-            [](const glm::dvec2& a, const glm::dvec2& b) { return a.x < b.x || (a.x == b.x && a.y < b.y); });
-  if (pts.n < 3) return pts;
   std::array<glm::dvec2, 2 * kMaxPoints> hull;
-  std::size_t k = 0;
-  for (std::size_t i = 0; i < pts.n; ++i) {
-    while (k >= 2 && cross(hull[k - 2], hull[k - 1], pts.p[i]) <= 0) --k;
-    hull[k++] = pts.p[i];
-  }
-  for (std::size_t i = pts.n - 1, lower = k + 1; i-- > 0;) {
-    while (k >= lower && cross(hull[k - 2], hull[k - 1], pts.p[i]) <= 0) --k;
-    hull[k++] = pts.p[i];
-  }
+  const std::size_t k = occull::convex_hull(std::span<glm::dvec2>(pts.p.data(), pts.n), hull.data());
   Polygon out;
-  for (std::size_t i = 0; i + 1 < k; ++i) out.push(hull[i]);
+  for (std::size_t i = 0; i < k; ++i) out.push(hull[i]);
   return out;
 }
 

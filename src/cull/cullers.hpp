@@ -14,6 +14,7 @@ std::unique_ptr<Culler> make_perobject(const SceneIndex& index, const Options& o
 std::unique_ptr<Culler> make_chc(const SceneIndex& index, const Options& options);
 std::unique_ptr<Culler> make_chcpp(const SceneIndex& index, const Options& options);
 std::unique_ptr<Culler> make_nohc(const SceneIndex& index, const Options& options);
+std::unique_ptr<Culler> make_grid(const SceneIndex& index, const Options& options);
 std::unique_ptr<Culler> make_auto(const SceneIndex& index, const Options& options);
 
 }  // namespace occull::detail

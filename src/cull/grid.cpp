@@ -1,0 +1,208 @@
+// `grid`: uniform-grid occlusion culling with a per-frame query cap
+// (Seletsky, seed 003, chapter 4.3).
+//
+// The scene lives in a UniformGrid (occull/grid.hpp), not the BVH. Each frame:
+//  1. read every cell query of the last frame (they are a frame old, so done)
+//     and store per cell whether it was visible and until which frame that
+//     answer holds: visibility lasts `vis_duration` frames, invisibility
+//     `invis_duration`, both longer by `*_growth` per consecutive frame that
+//     hit the query cap, plus a random 0..2·(those frames) (query starvation,
+//     thesis 4.3.5);
+//  2. walk the cells the frustum meets in occlusion order (GridTraversal).
+//     A cell whose answer expired is queried again while fewer than `cap`
+//     queries ran this frame — a cell that was visible always is (the
+//     blinking fix). A cell whose answer says visible has its objects drawn:
+//     occluders of class `always`, and `sometimes` while fewer than
+//     `prepass` of them were drawn this frame, at once so that they occlude
+//     the cells behind (the thesis' depth pre-pass), the rest at the end,
+//     sorted by material (the colour pass).
+//
+// Deviations, each for a reason:
+//  - A cell the frustum did not meet in the last frame has no current
+//    answer; it is drawn while its first query runs (`unknown=visible`),
+//    where the thesis leaves it hidden (`unknown=hidden`) and every cell
+//    entering the view pops in a frame late.
+//  - The pre-pass draws in colour, once, instead of depth-only followed by
+//    a second colour draw: occull's Backend has one draw call, and drawing
+//    each object once is never slower.
+//  - Pre-pass draws are not conditional on the cell's query yet: the
+//    Backend has no conditional rendering (the thesis' fallback: render).
+//  - Queries use the box of what a cell holds (its objects clipped to the
+//    cell, `tight`), which covers every object part in the cell, instead of
+//    the whole cell box.
+//
+// Results are a frame late and capped: this culler is not conservative;
+// the verifier measures its popping.
+#include "cullers.hpp"
+#include "traversal.hpp"
+
+#include "occull/error.hpp"
+#include "occull/grid.hpp"
+
+#include <random>
+
+namespace occull::detail {
+namespace {
+
+struct GridConfig {
+  float cell = 0.0f;
+  GridTraversal::Mode traversal = GridTraversal::Mode::frustum;
+  int cap = 4000;
+  int vis_duration = 20, vis_growth = 4;
+  int invis_duration = 1, invis_growth = 1;
+  int prepass = 75;
+  bool unknown_visible = true;
+  bool tight = true;
+  std::uint64_t threshold = 0;
+  std::uint32_t seed = 1;
+};
+
+class GridCuller final : public Culler {
+ public:
+  GridCuller(const SceneIndex& index, const GridConfig& config)
+      : scene_(index.scene), config_(config), grid_(UniformGrid::of_scene(index.scene, config.cell)),
+        drawn_(index.scene.objects().size(), ~std::uint64_t(0)), rng_(config.seed) {}
+
+  ~GridCuller() override {
+    if (!backend_) return;
+    for (const Pending& p : pending_) (void)backend_->result(p.query);
+  }
+
+  FrameStats render_frame(const View& view, Backend& backend) override {
+    FrameStats stats;
+    backend_ = &backend;
+    for (ObjectId id : scene_.dynamic_objects()) grid_.update(id, scene_.object(id).bounds);
+    if (cells_.size() < grid_.occupied()) cells_.resize(grid_.occupied());
+    gather(backend);
+    ++frame_;
+
+    const float near_radius = near_plane_radius(view);
+    int queries = 0, prepass = 0;
+    bool capped = false;
+    colour_.clear();
+    for (const CellRun& run : traversal_.traverse(grid_.geometry(), view, config_.traversal)) {
+      for (int i = 0; i < run.count; ++i) {
+        ++stats.nodes_visited;
+        const std::uint32_t c = grid_.find(run.start + run.step * i);
+        if (c == UniformGrid::kNoCell || grid_.objects(c).empty()) continue;
+        Cell& cell = cells_[c];
+        const bool seen_last_frame = cell.seen + 1 == frame_;
+        cell.seen = frame_;
+        const Aabb box = config_.tight ? grid_.content_box(c) : grid_.geometry().cell_box(grid_.coord(c));
+        bool draw = cell.visible && cell.until >= frame_;
+        bool requery = cell.until <= frame_;
+        if (!seen_last_frame && !draw && config_.unknown_visible) draw = requery = true;
+        if (near_eye(box, view, near_radius)) {
+          // Around the eye: visible, and its query could miss the faces around the camera.
+          draw = true;
+          requery = false;
+          cell.visible = true;
+          cell.until = frame_;
+        }
+        if (requery) {
+          if (queries >= config_.cap && !capped) {
+            capped = true;
+            ++capped_frames_;
+          }
+          if (queries < config_.cap || draw) {
+            pending_.push_back({backend.issue_query(std::span<const Aabb>(&box, 1)), c});
+            ++queries;
+            ++stats.query_batches;
+          }
+        }
+        if (!draw) continue;
+        prepass_.clear();
+        for (ObjectId id : grid_.objects(c)) {
+          if (drawn_[id] == frame_) continue;
+          drawn_[id] = frame_;
+          if (occludes(id, prepass)) {
+            prepass_.push_back(id);
+            ++prepass;
+          } else {
+            colour_.push_back(id);
+          }
+        }
+        if (!prepass_.empty()) backend.render(prepass_);
+      }
+    }
+    if (!capped) capped_frames_ = 0;
+    backend.flush();  // the queries run while the colour pass is drawn
+    if (!colour_.empty()) backend.render(colour_);
+    return stats;
+  }
+
+ private:
+  struct Cell {
+    std::uint64_t until = 0;       // the last frame the stored answer holds (expiry)
+    std::uint64_t seen = ~std::uint64_t(0);  // last frame the traversal met the cell
+    bool visible = false;
+  };
+  struct Pending {
+    QueryId query;
+    std::uint32_t cell;
+  };
+
+  // Last frame's answers. The frame number is still last frame's here, as
+  // in the thesis' pseudo-code.
+  void gather(Backend& backend) {
+    const int grow = capped_frames_;
+    std::uniform_int_distribution<int> offset(0, 2 * grow);
+    for (const Pending& p : pending_) {
+      Cell& cell = cells_[p.cell];
+      cell.visible = backend.result(p.query) > config_.threshold;
+      const int base = cell.visible ? config_.vis_duration + config_.vis_growth * grow
+                                    : config_.invis_duration + config_.invis_growth * grow;
+      cell.until = frame_ + std::uint64_t(base) + std::uint64_t(grow > 0 ? offset(rng_) : 0);
+    }
+    pending_.clear();
+  }
+
+  // Whether object `id` goes to the pre-pass, given `drawn` pre-pass objects so far.
+  bool occludes(ObjectId id, int drawn) const {
+    const Object& o = scene_.object(id);
+    if (scene_.material(o.material).translucent) return false;
+    return o.occluder == OccluderClass::always ||
+           (o.occluder == OccluderClass::sometimes && drawn < config_.prepass);
+  }
+
+  const Scene& scene_;
+  GridConfig config_;
+  UniformGrid grid_;
+  GridTraversal traversal_;
+  std::vector<Cell> cells_;             // per occupied cell
+  std::vector<std::uint64_t> drawn_;    // per object: last frame it was drawn (once per frame)
+  std::vector<Pending> pending_;        // this frame's queries, read next frame
+  std::vector<ObjectId> prepass_, colour_;
+  std::uint64_t frame_ = 0;
+  int capped_frames_ = 0;               // consecutive frames that hit the cap
+  std::mt19937 rng_;
+  Backend* backend_ = nullptr;          // of the last frame, to drain running queries
+};
+
+}  // namespace
+
+std::unique_ptr<Culler> make_grid(const SceneIndex& index, const Options& o) {
+  GridConfig c;
+  c.cell = float(o.get_double("grid.cell", 0.0, 0.0, 1e9));
+  const std::string traversal = o.values().count("grid.traversal") ? o.values().at("grid.traversal") : "frustum";
+  if (traversal == "box")
+    c.traversal = GridTraversal::Mode::box;
+  else if (traversal != "frustum")
+    throw InputError("option grid.traversal: '" + traversal + "' is not one of frustum, box");
+  c.cap = o.get_int("grid.cap", c.cap, 1, 1 << 24);
+  c.vis_duration = o.get_int("grid.vis_duration", c.vis_duration, 1, 1 << 16);
+  c.vis_growth = o.get_int("grid.vis_growth", c.vis_growth, 0, 1 << 16);
+  c.invis_duration = o.get_int("grid.invis_duration", c.invis_duration, 1, 1 << 16);
+  c.invis_growth = o.get_int("grid.invis_growth", c.invis_growth, 0, 1 << 16);
+  c.prepass = o.get_int("grid.prepass", c.prepass, 0, 1 << 24);
+  const std::string unknown = o.values().count("grid.unknown") ? o.values().at("grid.unknown") : "visible";
+  if (unknown != "visible" && unknown != "hidden")
+    throw InputError("option grid.unknown: '" + unknown + "' is not one of visible, hidden");
+  c.unknown_visible = unknown == "visible";
+  c.tight = o.get_bool("grid.tight", c.tight);
+  c.threshold = std::uint64_t(o.get_int("grid.threshold", 0, 0, 1 << 24));
+  c.seed = std::uint32_t(o.get_int("grid.seed", 1, 0, 1 << 30));
+  return std::make_unique<GridCuller>(index, c);
+}
+
+}  // namespace occull::detail

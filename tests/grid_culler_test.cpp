@@ -1,0 +1,140 @@
+// `grid` (seed 003's uniform-grid culling) against a Backend test double
+// whose answers the test controls.
+#include "occull/culler.hpp"
+#include "test_util.hpp"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+
+using namespace occull;
+
+namespace {
+
+// Camera at the origin looking down -Z through a grid of 2 m cells. Object
+// 0: a wall 10 m ahead (class always); 1: a box behind it (never); 2: a
+// long kerb beside the path spanning many cells (sometimes); 3: a box 30 m
+// to the left, outside the frustum (never).
+struct Stage {
+  Scene scene{"grid"};
+  Bvh bvh;
+  View view = make_view({{0, 1, 0}, 0, 0}, {60.0f, 0.5f, 100.0f}, 64, 64);
+  Stage() {
+    const MaterialId grey = scene.add_material({"grey", {0.6f, 0.6f, 0.6f, 1}, false, 0});
+    const auto add = [&](const Aabb& b, OccluderClass c) {
+      scene.add_object(scene.add_mesh(test::box_mesh(b)), grey, glm::mat4(1.0f), c);
+    };
+    add({{-3, 0, -11}, {3, 6, -10}}, OccluderClass::always);
+    add({{-1, 0, -21}, {1, 2, -19}}, OccluderClass::never);
+    add({{3, 0, -30}, {4, 0.5f, -2}}, OccluderClass::sometimes);
+    add({{-31, 0, -11}, {-30, 1, -10}}, OccluderClass::never);
+    bvh = Bvh::build(scene);
+  }
+  std::unique_ptr<Culler> make(std::vector<std::string> options = {}) {
+    Options o;
+    o.set("grid.cell=2");
+    for (const auto& s : options) o.set(s);
+    return make_culler("grid", {scene, bvh}, o);
+  }
+};
+
+// Occluded: boxes entirely behind the wall's plane and within its width.
+std::uint64_t behind_wall(std::span<const Aabb> boxes) {
+  std::uint64_t samples = 0;
+  for (const Aabb& b : boxes) {
+    const bool hidden = b.max.z < -11.0f && b.min.x > -3.0f && b.max.x < 3.0f && b.max.y < 6.0f;
+    samples += hidden ? 0 : 1;
+  }
+  return samples;
+}
+
+std::size_t times_drawn(const test::RecordingBackend& b, ObjectId id) {
+  return std::size_t(std::count(b.rendered.begin(), b.rendered.end(), id));
+}
+
+}  // namespace
+
+TEST(Grid, HidesAnOccludedCellFromTheFrameAfterItsQueryAndQueriesItAgainEachFrame) {
+  Stage s;
+  test::RecordingBackend backend;  // outlives the culler, which reads its last queries on destruction
+  auto culler = s.make();
+  backend.visible_samples = behind_wall;
+  for (int frame = 1; frame <= 4; ++frame) {
+    backend.rendered.clear();
+    const std::size_t queries_before = backend.queried.size();
+    culler->render_frame(s.view, backend);
+    // Frame 1 has no answers yet: a cell the frustum did not meet is drawn.
+    EXPECT_EQ(times_drawn(backend, 1), frame == 1 ? 1u : 0u) << "frame " << frame;
+    EXPECT_EQ(times_drawn(backend, 0), 1u) << "frame " << frame;
+    EXPECT_EQ(times_drawn(backend, 3), 0u) << "outside the frustum, frame " << frame;
+    EXPECT_GT(backend.queried.size(), queries_before) << "frame " << frame;
+  }
+  // The occluded box's cell is queried every frame (invis_duration 1).
+  const Aabb hidden = s.scene.object(1).bounds;
+  const auto queries_of_hidden = std::count_if(backend.queried.begin(), backend.queried.end(), [&](const auto& q) {
+    return q.size() == 1 && hidden.contains(q[0].center());
+  });
+  EXPECT_GE(queries_of_hidden, 4);
+}
+
+TEST(Grid, TheThesisLeavesCellsWithoutAnAnswerHidden) {
+  Stage s;
+  test::RecordingBackend backend;
+  auto culler = s.make({"grid.unknown=hidden"});
+  culler->render_frame(s.view, backend);
+  EXPECT_TRUE(backend.rendered.empty());
+  culler->render_frame(s.view, backend);
+  EXPECT_EQ(times_drawn(backend, 0), 1u);
+}
+
+TEST(Grid, VisibleAnswersHoldForVisDurationFrames) {
+  Stage s;
+  test::RecordingBackend backend;
+  auto culler = s.make({"grid.vis_duration=5", "grid.vis_growth=0"});
+  std::vector<std::size_t> per_frame;
+  for (int frame = 1; frame <= 12; ++frame) {
+    const std::size_t before = backend.queried.size();
+    culler->render_frame(s.view, backend);
+    per_frame.push_back(backend.queried.size() - before);
+  }
+  // Every cell is visible: queried in frame 1, then again 5 frames later.
+  EXPECT_GT(per_frame[0], 0u);
+  for (int f : {1, 2, 3, 4, 6, 7, 8, 9, 11}) EXPECT_EQ(per_frame[std::size_t(f)], 0u) << "frame " << f + 1;
+  EXPECT_EQ(per_frame[5], per_frame[0]);
+  EXPECT_EQ(per_frame[10], per_frame[0]);
+}
+
+TEST(Grid, CapsQueriesExceptForCellsThatWereVisible) {
+  Stage s;
+  test::RecordingBackend backend;
+  {
+    // Without answers every cell is hidden: the cap holds.
+    auto culler = s.make({"grid.cap=2", "grid.unknown=hidden"});
+    culler->render_frame(s.view, backend);
+    EXPECT_EQ(backend.queried.size(), 2u);
+  }
+  {
+    // Cells visible by their answer are queried past the cap (the blinking fix).
+    auto culler = s.make({"grid.cap=2", "grid.vis_duration=1", "grid.vis_growth=0"});
+    culler->render_frame(s.view, backend);
+    const std::size_t before = backend.queried.size();
+    culler->render_frame(s.view, backend);
+    EXPECT_GT(backend.queried.size() - before, 2u);
+  }
+}
+
+TEST(Grid, DrawsAnObjectOncePerFrameOccludersFirst) {
+  Stage s;
+  test::RecordingBackend backend;  // outlives the culler, which reads its last queries on destruction
+  auto culler = s.make();
+  for (int frame = 1; frame <= 3; ++frame) {
+    backend.rendered.clear();
+    culler->render_frame(s.view, backend);
+    EXPECT_EQ(times_drawn(backend, 2), 1u) << "the kerb spans many cells, frame " << frame;
+    // The wall (class always) is drawn in the pre-pass, before the box of class never.
+    const auto wall = std::find(backend.rendered.begin(), backend.rendered.end(), 0u);
+    const auto box = std::find(backend.rendered.begin(), backend.rendered.end(), 1u);
+    ASSERT_NE(wall, backend.rendered.end());
+    if (box != backend.rendered.end()) EXPECT_LT(wall, box);
+  }
+}
