@@ -138,3 +138,30 @@ TEST(Grid, DrawsAnObjectOncePerFrameOccludersFirst) {
     if (box != backend.rendered.end()) EXPECT_LT(wall, box);
   }
 }
+
+TEST(Grid, CountsCappedFramesDeferredQueriesAndTheAgeOfItsAnswers) {
+  Stage s;
+  test::RecordingBackend backend;
+  std::size_t due = 0;  // cells due a query in the first frame: every non-empty one in view
+  {
+    auto culler = s.make({"grid.unknown=hidden"});
+    const FrameStats f = culler->render_frame(s.view, backend);
+    due = backend.queried.size();
+    EXPECT_EQ(f.capped, 0u);
+    EXPECT_EQ(f.over_cap, 0u);
+  }
+  ASSERT_GT(due, 2u);
+  {
+    auto culler = s.make({"grid.cap=2", "grid.unknown=hidden"});
+    const FrameStats f = culler->render_frame(s.view, backend);
+    EXPECT_EQ(f.capped, 1u);
+    EXPECT_EQ(f.over_cap, due - 2);
+  }
+  {
+    // Answers come from frame 1's queries and hold 5 frames: 1, 2, 3 frames old.
+    auto culler = s.make({"grid.vis_duration=5", "grid.vis_growth=0"});
+    EXPECT_EQ(culler->render_frame(s.view, backend).result_age, 0.0) << "no answers yet";
+    for (int frame = 2; frame <= 4; ++frame)
+      EXPECT_DOUBLE_EQ(culler->render_frame(s.view, backend).result_age, double(frame - 1)) << "frame " << frame;
+  }
+}

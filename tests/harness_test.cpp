@@ -330,6 +330,12 @@ TEST(Report, JsonCarriesEveryDocumentedField) {
   write_csv(r, csv);
   const std::string text = csv.str();
   EXPECT_EQ(std::count(text.begin(), text.end(), '\n'), 1 + 6 * 4);
+  // Every row has a value for every column of the header.
+  std::istringstream rows(text);
+  std::string header, row;
+  std::getline(rows, header);
+  const auto columns = std::count(header.begin(), header.end(), ',');
+  while (std::getline(rows, row)) EXPECT_EQ(std::count(row.begin(), row.end(), ','), columns) << row;
 
   // Report folder: Markdown plus well-formed SVG charts.
   const std::string dir = ::testing::TempDir() + "occull_report_test";

@@ -242,6 +242,9 @@ struct AlgorithmSummary {
   double multiqueries_per_frame = 0.0;
   double failed_multiqueries_per_frame = 0.0;
   double query_batches_per_frame = 0.0;
+  double capped_share = 0.0;              ///< share of frames that reached the query cap (FrameStats::capped)
+  double over_cap_per_frame = 0.0;        ///< queries deferred by the cap (FrameStats::over_cap)
+  double result_age_frames = 0.0;         ///< mean age of the answers used (FrameStats::result_age)
   double state_changes_per_frame = 0.0;
   double render_flushes_per_frame = 0.0;
   double draw_calls_per_frame = 0.0;

@@ -27,6 +27,12 @@ struct FrameStats {
   std::uint64_t multiqueries = 0;         ///< queries covering more than one node
   std::uint64_t failed_multiqueries = 0;  ///< multiqueries that came back visible
   std::uint64_t query_batches = 0;        ///< batches of queries issued together
+  // Query cap (grid): whether this frame reached the per-frame cap, how many
+  // cells were due a query the cap deferred, and how old (in frames) the
+  // visibility answers were that decided what to draw, on average.
+  std::uint64_t capped = 0;      ///< 1 when the frame reached the culler's query cap, else 0
+  std::uint64_t over_cap = 0;    ///< queries due but deferred by the cap
+  double result_age = 0.0;       ///< mean frames since the query behind each answer used was issued
 
   // Backend counters (differences over the frame).
   std::uint64_t queries = 0;

@@ -79,6 +79,7 @@ class GridCuller final : public Culler {
     const float near_radius = near_plane_radius(view);
     int queries = 0, prepass = 0;
     bool capped = false;
+    std::uint64_t answers = 0, age = 0;
     colour_.clear();
     for (const CellRun& run : traversal_.traverse(grid_.geometry(), view, config_.traversal)) {
       for (int i = 0; i < run.count; ++i) {
@@ -91,13 +92,17 @@ class GridCuller final : public Culler {
         const Aabb box = config_.tight ? grid_.content_box(c) : grid_.geometry().cell_box(grid_.coord(c));
         bool draw = cell.visible && cell.until >= frame_;
         bool requery = cell.until <= frame_;
-        if (!seen_last_frame && !draw && config_.unknown_visible) draw = requery = true;
+        const bool unknown = !seen_last_frame && !draw;
+        if (unknown && config_.unknown_visible) draw = requery = true;
         if (near_eye(box, view, near_radius)) {
           // Around the eye: visible, and its query could miss the faces around the camera.
           draw = true;
           requery = false;
           cell.visible = true;
-          cell.until = frame_;
+          cell.until = cell.asked = frame_;
+        } else if (!unknown) {
+          ++answers;
+          age += frame_ - cell.asked;
         }
         if (requery) {
           if (queries >= config_.cap && !capped) {
@@ -108,6 +113,8 @@ class GridCuller final : public Culler {
             pending_.push_back({backend.issue_query(std::span<const Aabb>(&box, 1)), c});
             ++queries;
             ++stats.query_batches;
+          } else {
+            ++stats.over_cap;
           }
         }
         if (!draw) continue;
@@ -126,6 +133,8 @@ class GridCuller final : public Culler {
       }
     }
     if (!capped) capped_frames_ = 0;
+    stats.capped = capped ? 1 : 0;
+    stats.result_age = answers > 0 ? double(age) / double(answers) : 0.0;
     backend.flush();  // the queries run while the colour pass is drawn
     if (!colour_.empty()) backend.render(colour_);
     return stats;
@@ -135,6 +144,7 @@ class GridCuller final : public Culler {
   struct Cell {
     std::uint64_t until = 0;       // the last frame the stored answer holds (expiry)
     std::uint64_t seen = ~std::uint64_t(0);  // last frame the traversal met the cell
+    std::uint64_t asked = 0;       // the frame whose query gave the stored answer
     bool visible = false;
   };
   struct Pending {
@@ -150,6 +160,7 @@ class GridCuller final : public Culler {
     for (const Pending& p : pending_) {
       Cell& cell = cells_[p.cell];
       cell.visible = backend.result(p.query) > config_.threshold;
+      cell.asked = frame_;
       const int base = cell.visible ? config_.vis_duration + config_.vis_growth * grow
                                     : config_.invis_duration + config_.invis_growth * grow;
       cell.until = frame_ + std::uint64_t(base) + std::uint64_t(grow > 0 ? offset(rng_) : 0);

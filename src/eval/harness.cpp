@@ -354,6 +354,9 @@ std::vector<AlgorithmSummary> summarize_runs(std::span<const AlgorithmRun> runs)
         sums["multiqueries"] += double(f.multiqueries);
         sums["failed_multiqueries"] += double(f.failed_multiqueries);
         sums["query_batches"] += double(f.query_batches);
+        sums["capped"] += double(f.capped);
+        sums["over_cap"] += double(f.over_cap);
+        sums["result_age"] += f.result_age;
         sums["state_changes"] += double(f.state_changes);
         sums["render_flushes"] += double(f.render_flushes);
         sums["draw_calls"] += double(f.draw_calls);
@@ -405,6 +408,9 @@ std::vector<AlgorithmSummary> summarize_runs(std::span<const AlgorithmRun> runs)
     a.multiqueries_per_frame = med("multiqueries");
     a.failed_multiqueries_per_frame = med("failed_multiqueries");
     a.query_batches_per_frame = med("query_batches");
+    a.capped_share = med("capped");
+    a.over_cap_per_frame = med("over_cap");
+    a.result_age_frames = med("result_age");
     a.state_changes_per_frame = med("state_changes");
     a.render_flushes_per_frame = med("render_flushes");
     a.draw_calls_per_frame = med("draw_calls");

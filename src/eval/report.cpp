@@ -127,6 +127,11 @@ void print_table(const BenchResult& r, std::ostream& out) {
   }
   if (r.verified) out << "\n";
   for (const std::string& line : verdict_lines(r)) out << line << "\n";
+  for (const AlgorithmSummary& a : r.summaries)
+    if (a.result_age_frames > 0 || a.capped_share > 0)
+      out << fmt::format("{}: query cap reached in {:.0f}% of frames, {:.1f} queries deferred per frame, answers "
+                         "used were {:.1f} frames old on average\n",
+                         a.name, 100.0 * a.capped_share, a.over_cap_per_frame, a.result_age_frames);
   out << fmt::format("\nwhere the time goes (per frame)\n{:<{}} {:>7} {:>8} {:>8} {:>8} {:>7} {:>8} {:>8} {:>8} {:>7}\n",
                      "algorithm", w, "cpu ms", "us/node", "nodes", "wait ms", "waits", "flushes", "gpu ms",
                      "faults", "sys ms");
@@ -201,6 +206,9 @@ nlohmann::ordered_json detail::bench_json(const BenchResult& r) {
                      {"multiqueries_per_frame", a.multiqueries_per_frame},
                      {"failed_multiqueries_per_frame", a.failed_multiqueries_per_frame},
                      {"query_batches_per_frame", a.query_batches_per_frame},
+                     {"capped_share", a.capped_share},
+                     {"over_cap_per_frame", a.over_cap_per_frame},
+                     {"result_age_frames", a.result_age_frames},
                      {"state_changes_per_frame", a.state_changes_per_frame},
                      {"render_flushes_per_frame", a.render_flushes_per_frame},
                      {"draw_calls_per_frame", a.draw_calls_per_frame},
@@ -236,17 +244,20 @@ void write_csv(const BenchResult& r, std::ostream& out) {
   out << "algorithm,repeat,frame,frame_ms,cpu_ms,wait_ms,gpu_ms,queries,query_boxes,multiqueries,"
          "failed_multiqueries,query_batches,state_changes,material_changes,render_flushes,"
          "draw_calls,triangles,objects_rendered,nodes_visited,truth_objects,missed_objects,"
-         "wrong_pixels,extra_objects,blocking_waits,model_ms,kernel_ms,minor_faults,major_faults,flushes\n";
+         "wrong_pixels,extra_objects,blocking_waits,model_ms,kernel_ms,minor_faults,major_faults,flushes,"
+         "capped,over_cap,result_age\n";
   for (const AlgorithmRun& run : r.runs) {
     for (std::size_t k = 0; k < run.frames.size(); ++k) {
       const FrameStats& f = run.frames[k];
-      out << fmt::format("{},{},{},{:.4f},{:.4f},{:.4f},{:.4f},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{:.4f}\n",
+      out << fmt::format("{},{},{},{:.4f},{:.4f},{:.4f},{:.4f},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},"
+                         "{:.4f},{:.4f},{},{},{},{},{},{:.3f}\n",
                          run.name, run.repeat, k, f.frame_ms, f.cpu_ms, f.wait_ms, f.gpu_ms, f.queries,
                          f.query_boxes, f.multiqueries, f.failed_multiqueries, f.query_batches,
                          f.state_changes, f.material_changes, f.render_flushes, f.draw_calls,
                          f.triangles, f.objects_rendered, f.nodes_visited, f.truth_objects,
                          f.missed_objects, f.wrong_pixels, f.extra_objects, f.blocking_waits, f.model_ms,
-                         f.kernel_ms, f.minor_faults, f.major_faults, f.flushes);
+                         f.kernel_ms, f.minor_faults, f.major_faults, f.flushes, f.capped, f.over_cap,
+                         f.result_age);
     }
   }
 }
