@@ -1,6 +1,7 @@
 // `grid` (seed 003's uniform-grid culling) against a Backend test double
 // whose answers the test controls.
 #include "occull/culler.hpp"
+#include "occull/grid.hpp"
 #include "test_util.hpp"
 
 #include <gtest/gtest.h>
@@ -163,5 +164,50 @@ TEST(Grid, CountsCappedFramesDeferredQueriesAndTheAgeOfItsAnswers) {
     EXPECT_EQ(culler->render_frame(s.view, backend).result_age, 0.0) << "no answers yet";
     for (int frame = 2; frame <= 4; ++frame)
       EXPECT_DOUBLE_EQ(culler->render_frame(s.view, backend).result_age, double(frame - 1)) << "frame " << frame;
+  }
+}
+
+TEST(Grid, PrePassOfACellQueriedThisFrameIsConditionalOnItsQueryUnlessAnObjectLeavesTheCell) {
+  Stage s;
+  // Object 4: an occluder inside one 2 m cell, in view.
+  const MaterialId grey = s.scene.object(0).material;
+  const Aabb small{{3.2f, 0.2f, -7.8f}, {4.8f, 1.8f, -6.2f}};
+  s.scene.add_object(s.scene.add_mesh(test::box_mesh(small)), grey, glm::mat4(1.0f), OccluderClass::always);
+  s.bvh = Bvh::build(s.scene);
+  const GridGeometry g = UniformGrid::of_scene(s.scene, 2.0f).geometry();
+  ASSERT_EQ(g.cell_of(small.min), g.cell_of(small.max)) << "the test's object must lie in one cell";
+
+  const auto conditional_ids = [](const test::RecordingBackend& b) {
+    std::vector<ObjectId> ids;
+    for (const auto& [id, q] : b.rendered_conditionally) ids.push_back(id);
+    return ids;
+  };
+  {
+    test::RecordingBackend backend;
+    backend.conditional = true;
+    auto culler = s.make();
+    culler->render_frame(s.view, backend);
+    // The small occluder depends on the query of its own cell, issued this frame.
+    ASSERT_EQ(conditional_ids(backend), std::vector<ObjectId>{4});
+    const QueryId q = backend.rendered_conditionally[0].second;
+    ASSERT_LT(q, backend.queried.size());
+    ASSERT_EQ(backend.queried[q].size(), 1u);
+    EXPECT_TRUE(backend.queried[q][0].contains(small.center()));
+    // The wall reaches into other cells: drawn unconditionally, once.
+    EXPECT_EQ(times_drawn(backend, 0), 1u);
+  }
+  {
+    test::RecordingBackend backend;
+    backend.conditional = true;
+    auto culler = s.make({"grid.conditional=off"});
+    culler->render_frame(s.view, backend);
+    EXPECT_TRUE(backend.rendered_conditionally.empty());
+    EXPECT_EQ(times_drawn(backend, 4), 1u);
+  }
+  {
+    test::RecordingBackend backend;  // no conditional rendering: drawn as usual
+    auto culler = s.make();
+    culler->render_frame(s.view, backend);
+    EXPECT_EQ(times_drawn(backend, 4), 1u);
   }
 }

@@ -5,6 +5,7 @@
 #include "occull/harness.hpp"
 #include "test_util.hpp"
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -190,6 +191,47 @@ TEST_F(RendererTest, IdBufferHoldsTheVisibleObjects) {
   EXPECT_EQ(ids_in(ids), (std::set<ObjectId>{WallScene::wall, WallScene::beside}));
   // The centre pixel shows the wall.
   EXPECT_EQ(ids[std::size_t(kSize / 2 * kSize + kSize / 2)], WallScene::wall + 1);
+}
+
+// Conditional rendering. The box beside the wall, drawn on the condition of
+// the hidden box's query, must not reach the image nor the frame's record;
+// the hidden box, drawn on the visible query of the box beside, is drawn
+// (and recorded) but stays behind the wall. Both wait modes, with the
+// queries read before and after end_frame().
+TEST_F(RendererTest, ConditionalDrawsTakeEffectOnlyWhereTheirQueryPassed) {
+  WallScene w;
+  gl::Renderer r(w.scene, small());
+  ASSERT_TRUE(r.conditional_rendering());
+  r.set_write_ids(true);
+  for (const ConditionalWait wait : {ConditionalWait::wait, ConditionalWait::no_wait}) {
+    for (const bool read_before_end : {true, false}) {
+      const std::string where = fmt::format("wait {}, read before end {}", int(wait), read_before_end);
+      begin_with_wall(r, w);
+      const ObjectId hidden[] = {WallScene::hidden}, beside[] = {WallScene::beside};
+      const Aabb hidden_box[] = {w.scene.object(WallScene::hidden).bounds};
+      const Aabb beside_box[] = {w.scene.object(WallScene::beside).bounds};
+      const QueryId qh = r.issue_query(hidden_box);
+      const QueryId qb = r.issue_query(beside_box);
+      // no_wait draws while a result is unknown: wait for both first.
+      for (int polls = 0; !(r.result_available(qh) && r.result_available(qb)); ++polls)
+        ASSERT_LT(polls, 1000000) << where;
+      r.render_conditional(beside, qh, wait);
+      r.render_conditional(hidden, qb, wait);
+      if (read_before_end) {
+        EXPECT_EQ(r.result(qh), 0u);
+        EXPECT_GT(r.result(qb), 0u);
+      }
+      r.end_frame();
+      const std::set<ObjectId> drawn(r.frame_objects().begin(), r.frame_objects().end());
+      EXPECT_EQ(drawn, (std::set<ObjectId>{WallScene::wall, WallScene::hidden})) << where;
+      EXPECT_EQ(ids_in(r.read_ids()), (std::set<ObjectId>{WallScene::wall})) << where;
+      if (!read_before_end) {
+        EXPECT_EQ(r.result(qh), 0u);
+        EXPECT_GT(r.result(qb), 0u);
+      }
+    }
+  }
+  EXPECT_EQ(r.queries_in_flight(), 0u);
 }
 
 TEST_F(RendererTest, ScreenshotHasTheObjectsOverTheBackground) {

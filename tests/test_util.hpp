@@ -74,11 +74,21 @@ class RecordingBackend final : public Backend {
   std::function<bool(QueryId)> available = [](QueryId) { return true; };
   std::vector<ObjectId> rendered;
   std::vector<std::vector<Aabb>> queried;
+  /// With conditional rendering on, render_conditional() records its
+  /// objects here as well as in `rendered`, with the query they depend on.
+  bool conditional = false;
+  std::vector<std::pair<ObjectId, QueryId>> rendered_conditionally;
 
   void render(std::span<const ObjectId> objects) override {
     rendered.insert(rendered.end(), objects.begin(), objects.end());
     ++stats_.render_flushes;
     stats_.draw_calls += objects.size();
+  }
+  [[nodiscard]] bool conditional_rendering() const override { return conditional; }
+  void render_conditional(std::span<const ObjectId> objects, QueryId q, ConditionalWait wait) override {
+    if (!conditional) return Backend::render_conditional(objects, q, wait);
+    for (ObjectId id : objects) rendered_conditionally.emplace_back(id, q);
+    render(objects);
   }
   QueryId issue_query(std::span<const Aabb> boxes) override {
     queried.emplace_back(boxes.begin(), boxes.end());

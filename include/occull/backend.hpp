@@ -46,6 +46,13 @@ struct BackendStats {
   }
 };
 
+/// What the device does with a conditional draw (Backend::render_conditional)
+/// whose query has no result yet.
+enum class ConditionalWait : std::uint8_t {
+  wait,     ///< waits for the result (GL_QUERY_WAIT): exact, may stall the device
+  no_wait,  ///< draws anyway (GL_QUERY_NO_WAIT): never stalls, skips only known-hidden draws
+};
+
 class Backend {
  public:
   virtual ~Backend() = default;
@@ -70,6 +77,24 @@ class Backend {
   /// that passed the depth test. Blocks until known, then frees q.
   /// Precondition: q in flight.
   virtual std::uint64_t result(QueryId q) = 0;
+
+  /// Whether render_conditional() can skip draws on the device. A backend
+  /// without conditional rendering draws everything there (as render()).
+  [[nodiscard]] virtual bool conditional_rendering() const { return false; }
+
+  /// Conditional rendering: render(objects), except that on the device the
+  /// draws take effect only if query `q` had samples pass; with
+  /// ConditionalWait::no_wait the device may draw while the result is not
+  /// known yet. Lets a culler act on a query in the same frame without
+  /// reading it on the CPU. Translucent objects are deferred and drawn
+  /// unconditionally. The query stays in flight: the caller still reads it
+  /// with result(). Preconditions: as render(); q issued and not yet read.
+  /// The default (no conditional rendering) draws them all.
+  virtual void render_conditional(std::span<const ObjectId> objects, QueryId q, ConditionalWait wait) {
+    (void)q;
+    (void)wait;
+    render(objects);
+  }
 
   /// Asks the device to start work submitted so far without waiting for it
   /// (glFlush); helps queries finish while the culler does other work.

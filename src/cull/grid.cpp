@@ -25,8 +25,11 @@
 //  - The pre-pass draws in colour, once, instead of depth-only followed by
 //    a second colour draw: occull's Backend has one draw call, and drawing
 //    each object once is never slower.
-//  - Pre-pass draws are not conditional on the cell's query yet: the
-//    Backend has no conditional rendering (the thesis' fallback: render).
+//  - The pre-pass of a cell queried this frame runs under conditional
+//    rendering on that query (`conditional`, where the Backend has it),
+//    as in the thesis, but only for objects inside the cell: an object
+//    that reaches into other cells is drawn once per frame, and the device
+//    skipping it here would leave its parts in the other cells undrawn.
 //  - Queries use the box of what a cell holds (its objects clipped to the
 //    cell, `tight`), which covers every object part in the cell, instead of
 //    the whole cell box.
@@ -39,6 +42,7 @@
 #include "occull/error.hpp"
 #include "occull/grid.hpp"
 
+#include <optional>
 #include <random>
 
 namespace occull::detail {
@@ -53,6 +57,7 @@ struct GridConfig {
   int prepass = 75;
   bool unknown_visible = true;
   bool tight = true;
+  std::optional<ConditionalWait> conditional = ConditionalWait::wait;  // none: off
   std::uint64_t threshold = 0;
   std::uint32_t seed = 1;
 };
@@ -104,13 +109,17 @@ class GridCuller final : public Culler {
           ++answers;
           age += frame_ - cell.asked;
         }
+        QueryId query = 0;
+        bool queried = false;
         if (requery) {
           if (queries >= config_.cap && !capped) {
             capped = true;
             ++capped_frames_;
           }
           if (queries < config_.cap || draw) {
-            pending_.push_back({backend.issue_query(std::span<const Aabb>(&box, 1)), c});
+            query = backend.issue_query(std::span<const Aabb>(&box, 1));
+            queried = true;
+            pending_.push_back({query, c});
             ++queries;
             ++stats.query_batches;
           } else {
@@ -118,18 +127,24 @@ class GridCuller final : public Culler {
           }
         }
         if (!draw) continue;
+        // The pre-pass of a cell queried now is conditional on that query,
+        // except for objects that reach into other cells: the device may
+        // skip them here, where they count as drawn for this frame.
+        const bool conditional = queried && config_.conditional && backend.conditional_rendering();
         prepass_.clear();
+        inside_.clear();
         for (ObjectId id : grid_.objects(c)) {
           if (drawn_[id] == frame_) continue;
           drawn_[id] = frame_;
           if (occludes(id, prepass)) {
-            prepass_.push_back(id);
+            (conditional && in_one_cell(id) ? inside_ : prepass_).push_back(id);
             ++prepass;
           } else {
             colour_.push_back(id);
           }
         }
         if (!prepass_.empty()) backend.render(prepass_);
+        if (!inside_.empty()) backend.render_conditional(inside_, query, *config_.conditional);
       }
     }
     if (!capped) capped_frames_ = 0;
@@ -168,6 +183,11 @@ class GridCuller final : public Culler {
     pending_.clear();
   }
 
+  bool in_one_cell(ObjectId id) const {
+    const Aabb& b = scene_.object(id).bounds;
+    return grid_.geometry().cell_of(b.min) == grid_.geometry().cell_of(b.max);
+  }
+
   // Whether object `id` goes to the pre-pass, given `drawn` pre-pass objects so far.
   bool occludes(ObjectId id, int drawn) const {
     const Object& o = scene_.object(id);
@@ -183,7 +203,7 @@ class GridCuller final : public Culler {
   std::vector<Cell> cells_;             // per occupied cell
   std::vector<std::uint64_t> drawn_;    // per object: last frame it was drawn (once per frame)
   std::vector<Pending> pending_;        // this frame's queries, read next frame
-  std::vector<ObjectId> prepass_, colour_;
+  std::vector<ObjectId> prepass_, inside_, colour_;
   std::uint64_t frame_ = 0;
   int capped_frames_ = 0;               // consecutive frames that hit the cap
   std::mt19937 rng_;
@@ -211,6 +231,14 @@ std::unique_ptr<Culler> make_grid(const SceneIndex& index, const Options& o) {
     throw InputError("option grid.unknown: '" + unknown + "' is not one of visible, hidden");
   c.unknown_visible = unknown == "visible";
   c.tight = o.get_bool("grid.tight", c.tight);
+  const std::string conditional =
+      o.values().count("grid.conditional") ? o.values().at("grid.conditional") : "wait";
+  if (conditional == "off")
+    c.conditional.reset();
+  else if (conditional == "wait" || conditional == "no_wait")
+    c.conditional = conditional == "wait" ? ConditionalWait::wait : ConditionalWait::no_wait;
+  else
+    throw InputError("option grid.conditional: '" + conditional + "' is not one of wait, no_wait, off");
   c.threshold = std::uint64_t(o.get_int("grid.threshold", 0, 0, 1 << 24));
   c.seed = std::uint32_t(o.get_int("grid.seed", 1, 0, 1 << 30));
   return std::make_unique<GridCuller>(index, c);

@@ -300,7 +300,34 @@ struct Renderer::Impl {
   bool query_culls_back = true;
   std::vector<ObjectId> opaque;
   std::vector<ObjectId> translucent;  // deferred to end_frame
-  std::vector<ObjectId> frame_objects;  // everything render() got this frame
+  std::vector<ObjectId> frame_objects;  // everything drawn this frame (see frame_objects())
+  // Conditional draws of this frame whose query result is not known yet:
+  // their objects join frame_objects once it is, if samples passed.
+  struct ConditionalDraw {
+    QueryId query;
+    std::uint64_t serial;  // query_serial of the query when drawn
+    std::size_t begin, count;  // in conditional_objects
+  };
+  std::vector<ConditionalDraw> conditional;
+  std::vector<ObjectId> conditional_objects;
+  void settle(const ConditionalDraw& d, std::uint64_t samples) {
+    if (samples > 0)
+      frame_objects.insert(frame_objects.end(), conditional_objects.begin() + long(d.begin),
+                           conditional_objects.begin() + long(d.begin + d.count));
+  }
+  // Query q's result is `samples`: settles the draws conditional on it.
+  void settle_conditional(QueryId q, std::uint64_t samples) {
+    std::erase_if(conditional, [&](const ConditionalDraw& d) {
+      if (d.query != q || d.serial != query_serial[q]) return false;
+      settle(d, samples);
+      return true;
+    });
+  }
+  void start_frame_record() {
+    frame_objects.clear();
+    conditional.clear();
+    conditional_objects.clear();
+  }
   std::vector<Aabb> frame_query_boxes;     // every query box this frame
   std::vector<std::uint32_t> frame_query_sizes;
   GLuint truth_query = 0;             // GL_SAMPLES_PASSED, for visible_pixels only
@@ -689,7 +716,7 @@ void Renderer::Impl::prepare_pass(const View& view) {
   eye = view.eye;
   near_radius = near_plane_radius(view);
   translucent.clear();
-  frame_objects.clear();
+  start_frame_record();
   frame_query_boxes.clear();
   frame_query_sizes.clear();
   bound_material = ~0u;
@@ -740,6 +767,16 @@ double Renderer::end_frame() {
   }
   if (g.timer_supported) glEndQuery(GL_TIME_ELAPSED);
   glFinish();
+  // Conditional draws whose query the culler has not read: the device is
+  // done, so their results are there (read without freeing the query).
+  glBindBuffer(GL_QUERY_BUFFER, 0);
+  for (const Impl::ConditionalDraw& d : g.conditional) {
+    assert(d.serial == g.query_serial[d.query]);  // not read, so not reissued
+    GLuint64 samples = 0;
+    glGetQueryObjectui64v(g.query_names[d.query], GL_QUERY_RESULT, &samples);
+    g.settle(d, samples);
+  }
+  g.conditional.clear();
   double gpu_ms = 0.0;
   if (g.timer_supported) {
     GLuint64 ns = 0;
@@ -766,6 +803,32 @@ void Renderer::render(std::span<const ObjectId> objects) {
     return g.scene.object(a).material < g.scene.object(b).material;
   });
   if (!g.opaque.empty()) g.draw_objects(g.opaque, stats_);
+}
+
+void Renderer::render_conditional(std::span<const ObjectId> objects, QueryId q, ConditionalWait wait) {
+  Impl& g = *impl_;
+  assert(q < g.query_names.size());
+  ScopedTimer timer(stats_.backend_ms);
+  ++stats_.render_flushes;
+  g.opaque.clear();
+  for (ObjectId id : objects) {
+    if (g.scene.material(g.scene.object(id).material).translucent) {
+      g.translucent.push_back(id);
+      g.frame_objects.push_back(id);
+    } else {
+      g.opaque.push_back(id);
+    }
+  }
+  if (g.opaque.empty()) return;
+  std::stable_sort(g.opaque.begin(), g.opaque.end(), [&](ObjectId a, ObjectId b) {
+    return g.scene.object(a).material < g.scene.object(b).material;
+  });
+  g.conditional.push_back({q, g.query_serial[q], g.conditional_objects.size(), g.opaque.size()});
+  g.conditional_objects.insert(g.conditional_objects.end(), g.opaque.begin(), g.opaque.end());
+  g.enter_render_state(stats_);
+  glBeginConditionalRender(g.query_names[q], wait == ConditionalWait::wait ? GL_QUERY_WAIT : GL_QUERY_NO_WAIT);
+  g.draw_objects(g.opaque, stats_);
+  glEndConditionalRender();
 }
 
 QueryId Renderer::issue_query(std::span<const Aabb> boxes) {
@@ -840,6 +903,7 @@ std::uint64_t Renderer::result(QueryId q) {
   const double ms = ms_since(t0);
   stats_.wait_ms += ms;
   stats_.backend_ms += ms;
+  if (!g.conditional.empty()) g.settle_conditional(q, samples);
   g.free_queries.push_back(q);
   --g.in_flight;
   return samples;
@@ -911,7 +975,7 @@ std::uint64_t Renderer::samples_in_front(const View& view, std::span<const Objec
   g.prepare_pass(view);
   const std::uint64_t n = objects.empty() ? 0 : g.samples_passing(objects);
   glFinish();
-  g.frame_objects.clear();
+  g.start_frame_record();
   check_error("counting samples in front of the depth buffer");
   return n;
 }
@@ -959,7 +1023,7 @@ std::vector<Renderer::ObjectPixels> Renderer::visible_pixels(const View& view,
     if (g.pixel_counts[id] > 0) visible.push_back({id, g.pixel_counts[id]});
 
   set_write_ids(saved_ids);
-  g.frame_objects.clear();
+  g.start_frame_record();
   stats_ = saved_stats;
   return visible;
 }

@@ -127,10 +127,16 @@ class Renderer final : public Backend {
   bool result_available(QueryId q) override;
   std::uint64_t result(QueryId q) override;
   void flush() override;
+  [[nodiscard]] bool conditional_rendering() const override { return true; }
+  void render_conditional(std::span<const ObjectId> objects, QueryId q, ConditionalWait wait) override;
   [[nodiscard]] BackendStats stats() const override { return stats_; }
 
-  /// Objects passed to render() since begin_frame(), in call order
-  /// (translucent ones included).
+  /// Objects drawn since begin_frame(): those passed to render() in call
+  /// order (translucent ones included), and those of render_conditional()
+  /// whose query had samples pass, once that result is known (when the
+  /// culler reads it, at the latest in end_frame()). Under
+  /// ConditionalWait::no_wait the device may also have drawn the others;
+  /// their query found them hidden.
   [[nodiscard]] std::span<const ObjectId> frame_objects() const noexcept;
 
   /// Boxes of the queries issued since begin_frame(), in order, and how many
