@@ -206,6 +206,7 @@ TEST_F(RendererTest, ConditionalDrawsTakeEffectOnlyWhereTheirQueryPassed) {
   for (const ConditionalWait wait : {ConditionalWait::wait, ConditionalWait::no_wait}) {
     for (const bool read_before_end : {true, false}) {
       const std::string where = fmt::format("wait {}, read before end {}", int(wait), read_before_end);
+      const BackendStats before = r.stats();
       begin_with_wall(r, w);
       const ObjectId hidden[] = {WallScene::hidden}, beside[] = {WallScene::beside};
       const Aabb hidden_box[] = {w.scene.object(WallScene::hidden).bounds};
@@ -225,6 +226,9 @@ TEST_F(RendererTest, ConditionalDrawsTakeEffectOnlyWhereTheirQueryPassed) {
       const std::set<ObjectId> drawn(r.frame_objects().begin(), r.frame_objects().end());
       EXPECT_EQ(drawn, (std::set<ObjectId>{WallScene::wall, WallScene::hidden})) << where;
       EXPECT_EQ(ids_in(r.read_ids()), (std::set<ObjectId>{WallScene::wall})) << where;
+      const BackendStats d = r.stats() - before;
+      EXPECT_EQ(d.conditional_objects, 2u) << where;
+      EXPECT_EQ(d.conditional_skipped, 1u) << where;
       if (!read_before_end) {
         EXPECT_EQ(r.result(qh), 0u);
         EXPECT_GT(r.result(qb), 0u);

@@ -33,6 +33,8 @@ struct BackendStats {
   /// query issued after the last one (drivers flush for those). Each ends
   /// a command batch; on llvmpipe each costs a thread wake-up and memory churn.
   std::uint64_t flushes = 0;
+  std::uint64_t conditional_objects = 0;  ///< opaque objects drawn by render_conditional()
+  std::uint64_t conditional_skipped = 0;  ///< ... of them whose query passed no samples (device skipped them)
   double wait_ms = 0.0;                ///< wall time blocked inside result(), milliseconds
   double backend_ms = 0.0;             ///< wall time inside any Backend call, milliseconds
 
@@ -42,6 +44,7 @@ struct BackendStats {
             a.queries - b.queries,             a.query_boxes - b.query_boxes,
             a.state_changes - b.state_changes, a.material_changes - b.material_changes,
             a.blocking_waits - b.blocking_waits, a.flushes - b.flushes,
+            a.conditional_objects - b.conditional_objects, a.conditional_skipped - b.conditional_skipped,
             a.wait_ms - b.wait_ms,             a.backend_ms - b.backend_ms};
   }
 };

@@ -250,6 +250,8 @@ struct AlgorithmSummary {
   double draw_calls_per_frame = 0.0;
   double triangles_per_frame = 0.0;
   double objects_rendered_per_frame = 0.0;
+  double conditional_objects_per_frame = 0.0;  ///< drawn under conditional rendering (FrameStats)
+  double conditional_skipped_per_frame = 0.0;  ///< ... skipped by the device (FrameStats)
   double nodes_visited_per_frame = 0.0;
   double extra_objects_per_frame = 0.0;  ///< over-rendering (verified runs)
   double wait_ms_per_frame = 0.0;

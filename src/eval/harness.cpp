@@ -158,6 +158,8 @@ FrameStats Session::run_frame(Culler& culler, const View& view, double time_s) {
   s.draw_calls = d.draw_calls;
   s.triangles = d.triangles;
   s.objects_rendered = d.objects_rendered;
+  s.conditional_objects = d.conditional_objects;
+  s.conditional_skipped = d.conditional_skipped;
   culler.frame_finished(s);
   return s;
 }
@@ -362,6 +364,8 @@ std::vector<AlgorithmSummary> summarize_runs(std::span<const AlgorithmRun> runs)
         sums["draw_calls"] += double(f.draw_calls);
         sums["triangles"] += double(f.triangles);
         sums["objects_rendered"] += double(f.objects_rendered);
+        sums["conditional_objects"] += double(f.conditional_objects);
+        sums["conditional_skipped"] += double(f.conditional_skipped);
         sums["nodes_visited"] += double(f.nodes_visited);
         sums["extra_objects"] += double(f.extra_objects);
         sums["wait_ms"] += f.wait_ms;
@@ -416,6 +420,8 @@ std::vector<AlgorithmSummary> summarize_runs(std::span<const AlgorithmRun> runs)
     a.draw_calls_per_frame = med("draw_calls");
     a.triangles_per_frame = med("triangles");
     a.objects_rendered_per_frame = med("objects_rendered");
+    a.conditional_objects_per_frame = med("conditional_objects");
+    a.conditional_skipped_per_frame = med("conditional_skipped");
     a.nodes_visited_per_frame = med("nodes_visited");
     a.extra_objects_per_frame = med("extra_objects");
     a.wait_ms_per_frame = med("wait_ms");

@@ -310,16 +310,17 @@ struct Renderer::Impl {
   };
   std::vector<ConditionalDraw> conditional;
   std::vector<ObjectId> conditional_objects;
-  void settle(const ConditionalDraw& d, std::uint64_t samples) {
+  void settle(const ConditionalDraw& d, std::uint64_t samples, BackendStats& stats) {
+    if (samples == 0) stats.conditional_skipped += d.count;
     if (samples > 0)
       frame_objects.insert(frame_objects.end(), conditional_objects.begin() + long(d.begin),
                            conditional_objects.begin() + long(d.begin + d.count));
   }
   // Query q's result is `samples`: settles the draws conditional on it.
-  void settle_conditional(QueryId q, std::uint64_t samples) {
+  void settle_conditional(QueryId q, std::uint64_t samples, BackendStats& stats) {
     std::erase_if(conditional, [&](const ConditionalDraw& d) {
       if (d.query != q || d.serial != query_serial[q]) return false;
-      settle(d, samples);
+      settle(d, samples, stats);
       return true;
     });
   }
@@ -774,7 +775,7 @@ double Renderer::end_frame() {
     assert(d.serial == g.query_serial[d.query]);  // not read, so not reissued
     GLuint64 samples = 0;
     glGetQueryObjectui64v(g.query_names[d.query], GL_QUERY_RESULT, &samples);
-    g.settle(d, samples);
+    g.settle(d, samples, stats_);
   }
   g.conditional.clear();
   double gpu_ms = 0.0;
@@ -825,6 +826,7 @@ void Renderer::render_conditional(std::span<const ObjectId> objects, QueryId q, 
   });
   g.conditional.push_back({q, g.query_serial[q], g.conditional_objects.size(), g.opaque.size()});
   g.conditional_objects.insert(g.conditional_objects.end(), g.opaque.begin(), g.opaque.end());
+  stats_.conditional_objects += g.opaque.size();
   g.enter_render_state(stats_);
   glBeginConditionalRender(g.query_names[q], wait == ConditionalWait::wait ? GL_QUERY_WAIT : GL_QUERY_NO_WAIT);
   g.draw_objects(g.opaque, stats_);
@@ -903,7 +905,7 @@ std::uint64_t Renderer::result(QueryId q) {
   const double ms = ms_since(t0);
   stats_.wait_ms += ms;
   stats_.backend_ms += ms;
-  if (!g.conditional.empty()) g.settle_conditional(q, samples);
+  if (!g.conditional.empty()) g.settle_conditional(q, samples, stats_);
   g.free_queries.push_back(q);
   --g.in_flight;
   return samples;
