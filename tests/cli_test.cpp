@@ -53,7 +53,7 @@ enum Column { kMean = 1, kMedian, kP95, kMax, kVsVfc, kVsOracle, kQueries, kStat
 
 TEST(Cli, HelpOnEveryCommandNamesItsOptions) {
   const std::vector<std::pair<std::string, std::vector<std::string>>> commands = {
-      {"", {"bench", "calibrate", "render", "scenes", "algos", "info", "path", "Exit codes"}},
+      {"", {"bench", "sweep", "calibrate", "render", "scenes", "algos", "info", "path", "Exit codes"}},
       {"info", {"--help"}},
       {"scenes", {"--list-maps"}},
       {"algos", {"--help"}},
@@ -62,6 +62,7 @@ TEST(Cli, HelpOnEveryCommandNamesItsOptions) {
                  "--query-raster", "--query-margin", "--draw", "--verify", "--repeat", "--model", "--json",
                  "--suite", "--malloc"}},
       {"calibrate", {"--size", "--repeats", "--out", "--check"}},
+      {"sweep", {"--algo", "--vary", "--baseline", "--popping", "--longest", "--scene", "--frames", "--json"}},
       {"render", {"--scene", "--frame", "--fps", "--out"}}};
   for (const auto& [cmd, options] : commands) {
     const CliRun r = run(cmd + " --help");
@@ -464,4 +465,30 @@ TEST(Cli, UnknownSuiteListsTheValidOnesAndASuiteExcludesAScene) {
   const CliRun both = run("bench --suite quick --scene field --frames 1");
   EXPECT_EQ(both.code, 2) << both.output;
   EXPECT_NE(both.output.find("excludes"), std::string::npos) << both.output;
+}
+
+TEST(Cli, SweepRunsEverySettingBesideTheBaselineAndNamesTheBest) {
+  const CliRun r = run(std::string("sweep ") + kTinyCity +
+                       " --algo grid --vary cap=1,4000 --vary vis_duration=2,20 --frames 3 --warmup 1");
+  ASSERT_EQ(r.code, 0) << r.output;
+  // A row per setting: the swept values first, then the figures.
+  for (const char* cap : {"1", "4000"}) {
+    int rows = 0;
+    std::istringstream lines(r.output);
+    for (std::string line; std::getline(lines, line);)
+      rows += line.rfind(std::string(cap) + " ", 0) == 0 && line.find("%") != std::string::npos ? 1 : 0;
+    EXPECT_EQ(rows, 2) << "cap " << cap << ": " << r.output;
+  }
+  EXPECT_NE(r.output.find("beside it: vfc"), std::string::npos) << r.output;
+  const bool verdict = r.output.find("\nbest: grid:") != std::string::npos ||
+                       r.output.find("\nno setting misses at most 0.10%") != std::string::npos;
+  EXPECT_TRUE(verdict) << r.output;
+}
+
+TEST(Cli, SweepOfAnUnknownOptionListsTheValidOnes) {
+  const CliRun r = run("sweep --vary capp=1,2");
+  EXPECT_EQ(r.code, 2) << r.output;
+  EXPECT_NE(r.output.find("valid options: cell, traversal, cap"), std::string::npos) << r.output;
+  const CliRun two = run("sweep --algo grid,vfc --vary cap=1");
+  EXPECT_EQ(two.code, 2) << two.output;
 }

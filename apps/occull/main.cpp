@@ -18,6 +18,7 @@
 #include "occull/report.hpp"
 #include "occull/scenes.hpp"
 #include "occull/suite.hpp"
+#include "occull/sweep.hpp"
 
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
@@ -300,7 +301,7 @@ int run_suite(const BenchArgs& a, occull::BenchConfig c, bool report) {
   return 0;
 }
 
-int cmd_bench(const BenchArgs& a) {
+occull::BenchConfig bench_config(const BenchArgs& a) {
   occull::BenchConfig c;
   c.allocator = occull::apply_allocator_policy(occull::parse_allocator_policy(a.malloc_policy));
   c.scene = a.scene;
@@ -323,6 +324,11 @@ int cmd_bench(const BenchArgs& a) {
   c.bvh.max_leaf_objects = a.bvh_leaf;
   c.verify = parse_on_off("--verify", a.verify);
   c.model = a.model;
+  return c;
+}
+
+int cmd_bench(const BenchArgs& a) {
+  const occull::BenchConfig c = bench_config(a);
   const bool report = !a.no_report && !a.report.empty();
   if (!a.suite.empty()) return run_suite(a, c, report);
   const auto json = open_output(a.json);
@@ -347,6 +353,43 @@ int cmd_bench(const BenchArgs& a) {
     std::fprintf(stderr, "report: %s/report.md (%zu files)\n", a.report.c_str(), files.size());
   }
   // A conservative culler that misses a visible object is broken, whatever its frame time.
+  return occull::verification_failures(result).empty() ? 0 : kExitVerificationFailed;
+}
+
+struct SweepArgs {
+  BenchArgs bench;  // scene, path, frames, size, ...; bench.algos holds the algorithm
+  std::vector<std::string> vary;
+  std::string baseline = "vfc";
+  double popping = 0.1;
+  int longest = 3;
+};
+
+// `sweep`: one algorithm over every combination of --vary values, with the
+// baselines, in one interleaved benchmark; a table per setting.
+int cmd_sweep(const SweepArgs& a) {
+  if (a.bench.algos.empty() || a.bench.algos.find(',') != std::string::npos ||
+      a.bench.algos.find(':') != std::string::npos)
+    throw occull::InputError("--algo takes one algorithm name (its options: --vary, or --opt for fixed ones)");
+  if (!(a.popping >= 0.0 && a.popping <= 100.0))
+    throw occull::InputError(fmt::format("--popping {}: must be a percentage in [0, 100]", a.popping));
+  if (a.longest < 0) throw occull::InputError(fmt::format("--longest {}: must not be negative", a.longest));
+  const std::string& algo = a.bench.algos;
+  std::vector<occull::SweepAxis> axes;
+  for (const std::string& v : a.vary) axes.push_back(occull::parse_sweep_axis(algo, v));
+  BenchArgs b = a.bench;
+  b.algos = a.baseline;
+  for (const std::string& spec : occull::sweep_specs(algo, axes)) b.algos += (b.algos.empty() ? "" : ",") + spec;
+  const occull::BenchConfig c = bench_config(b);
+  const auto json = open_output(b.json);
+  Progress progress;
+  const auto result = occull::run_bench(c, std::ref(progress));
+  occull::print_sweep_table(result, algo, axes, {a.popping / 100.0, std::uint32_t(a.longest)}, std::cout);
+  std::cout.flush();
+  if (json) {
+    occull::write_json(result, *json);
+    json->flush();
+    check_written(*json, b.json);
+  }
   return occull::verification_failures(result).empty() ? 0 : kExitVerificationFailed;
 }
 
@@ -525,6 +568,42 @@ int main(int argc, char** argv) {
                 "object submission: single (one draw per object) or multi (one multi-draw per material run)")
       ->capture_default_str();
 
+  SweepArgs sweep;
+  sweep.bench.algos = "grid";
+  sweep.bench.frames = 60;
+  sweep.bench.size = "320x180";
+  auto* sw = app.add_subcommand(
+      "sweep", "run one algorithm over every combination of option values (--vary) and tabulate frame time "
+               "and popping per setting");
+  sw->add_option("--algo", sweep.bench.algos, "the algorithm swept (one name; see occull algos)")->capture_default_str();
+  sw->add_option("--vary", sweep.vary,
+                 "an option and its values, key=v1,v2,... (repeatable; every combination runs, at most 64)")
+      ->required();
+  sw->add_option("--baseline", sweep.baseline, "comma-separated algorithms run beside the settings (empty: none)")
+      ->capture_default_str();
+  sw->add_option("--popping", sweep.popping,
+                 "the best setting misses at most this percentage of the visible object-frames")
+      ->capture_default_str();
+  sw->add_option("--longest", sweep.longest, "... and no object for more than this many frames in a row")
+      ->capture_default_str();
+  sw->add_option("--scene", sweep.bench.scene, "scene spec name[:key=value,...] (see occull scenes)")
+      ->capture_default_str();
+  sw->add_option("--path", sweep.bench.path, "camera path (default: the scene's first), or file:PATH");
+  sw->add_option("--frames", sweep.bench.frames, "timed frames per setting")->capture_default_str();
+  sw->add_option("--warmup", sweep.bench.warmup, "untimed warm-up frames per setting")->capture_default_str();
+  sw->add_option("--fps", sweep.bench.fps, "frames at this rate of path time (0: spread over the whole path)")
+      ->capture_default_str();
+  sw->add_option("--start", sweep.bench.start, "with --fps: path time of the first frame, seconds")
+      ->capture_default_str();
+  sw->add_option("--size", sweep.bench.size, "render size WIDTHxHEIGHT")->capture_default_str();
+  sw->add_option("--opt", sweep.bench.opts, "fixed option algo.key=value for every setting (repeatable)");
+  sw->add_option("--repeat", sweep.bench.repeat, "run the whole set R times, interleaved; report medians")
+      ->capture_default_str();
+  sw->add_option("--verify", sweep.bench.verify, "check every frame against ground truth (on/off); popping needs it")
+      ->capture_default_str();
+  sw->add_option("--json", sweep.bench.json, "write the results as bench JSON to this file");
+  sw->add_option("--malloc", sweep.bench.malloc_policy, kMallocHelp)->capture_default_str();
+
   CalibrateArgs calibrate;
   b->add_option("--malloc", bench.malloc_policy, kMallocHelp)->capture_default_str();
   auto* suite_opt = b->add_option("--suite", bench.suite,
@@ -583,6 +662,7 @@ int main(int argc, char** argv) {
     if (cmd == "path") return cmd_path(path_args);
     if (cmd == "algos") return cmd_algos();
     if (cmd == "bench") return cmd_bench(bench);
+    if (cmd == "sweep") return cmd_sweep(sweep);
     if (cmd == "render") return cmd_render(render);
     if (cmd == "calibrate") return cmd_calibrate(calibrate);
   } catch (const occull::InputError& e) {

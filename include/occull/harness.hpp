@@ -269,6 +269,11 @@ struct AlgorithmSummary {
   std::uint64_t wrong_pixels = 0;         ///< sum over frames
   std::uint64_t worst_frame_wrong_pixels = 0;
   std::uint32_t longest_miss_frames = 0;
+  std::uint64_t truth_object_frames = 0;  ///< sum over frames of the objects visible in the truth
+  /// missed_objects / truth_object_frames: the share of visible object-frames missed (0 unverified).
+  [[nodiscard]] double missed_share() const noexcept {
+    return truth_object_frames > 0 ? double(missed_objects) / double(truth_object_frames) : 0.0;
+  }
 };
 
 struct BenchResult {

@@ -349,7 +349,7 @@ std::vector<AlgorithmSummary> summarize_runs(std::span<const AlgorithmRun> runs)
       const double n = std::max<double>(1.0, double(r.frames.size()));
       std::vector<double> ms;
       std::map<std::string, double> sums;
-      std::uint64_t missed = 0, frames_missing = 0, wrong = 0, worst = 0;
+      std::uint64_t missed = 0, frames_missing = 0, wrong = 0, worst = 0, truth = 0;
       for (const FrameStats& f : r.frames) {
         ms.push_back(f.frame_ms);
         sums["queries"] += double(f.queries);
@@ -378,6 +378,7 @@ std::vector<AlgorithmSummary> summarize_runs(std::span<const AlgorithmRun> runs)
         sums["minor_faults"] += double(f.minor_faults);
         sums["major_faults"] += double(f.major_faults);
         missed += f.missed_objects;
+        truth += f.truth_objects;
         frames_missing += f.missed_objects > 0 ? 1 : 0;
         wrong += f.wrong_pixels;
         worst = std::max(worst, f.wrong_pixels);
@@ -396,6 +397,7 @@ std::vector<AlgorithmSummary> summarize_runs(std::span<const AlgorithmRun> runs)
       ratio("vfc", "ratio_to_vfc");
       ratio("oracle", "ratio_to_oracle");
       a.missed_objects = std::max(a.missed_objects, missed);
+      a.truth_object_frames = std::max(a.truth_object_frames, truth);
       a.frames_with_misses = std::max(a.frames_with_misses, frames_missing);
       a.wrong_pixels = std::max(a.wrong_pixels, wrong);
       a.worst_frame_wrong_pixels = std::max(a.worst_frame_wrong_pixels, worst);

@@ -59,8 +59,9 @@ std::vector<std::string> verdict_lines(const BenchResult& r) {
     if (a.conservative) {
       exact += (exact.empty() ? "" : ", ") + a.name;
     } else {
-      popping += fmt::format("{}{}: {} missed over {} frames, longest {} frames", popping.empty() ? "" : "; ",
-                             a.name, a.missed_objects, a.frames_with_misses, a.longest_miss_frames);
+      popping += fmt::format("{}{}: {} missed ({:.2f}% of the visible object-frames) over {} frames, longest {} frames",
+                             popping.empty() ? "" : "; ", a.name, a.missed_objects, 100.0 * a.missed_share(),
+                             a.frames_with_misses, a.longest_miss_frames);
     }
   }
   const auto failures = verification_failures(r);
@@ -228,6 +229,7 @@ nlohmann::ordered_json detail::bench_json(const BenchResult& r) {
                      {"wrong_pixels", a.wrong_pixels},
                      {"worst_frame_wrong_pixels", a.worst_frame_wrong_pixels},
                      {"longest_miss_frames", a.longest_miss_frames},
+                     {"truth_object_frames", a.truth_object_frames},
                      {"wait_ms_per_frame", a.wait_ms_per_frame},
                      {"blocking_waits_per_frame", a.blocking_waits_per_frame},
                      {"flushes_per_frame", a.flushes_per_frame},
