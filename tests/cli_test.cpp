@@ -80,7 +80,7 @@ TEST(Cli, NoCommandIsAUsageErrorThatSaysSo) {
 TEST(Cli, UnknownCommandIsAUsageErrorThatNamesIt) {
   const CliRun r = run("frobnicate");
   EXPECT_EQ(r.code, 2);
-  EXPECT_NE(r.output.find("unknown command 'frobnicate'; valid commands: info, scenes, path, algos, bench, "
+  EXPECT_NE(r.output.find("unknown command 'frobnicate'; valid commands: info, scenes, path, algos, bench, sweep, "
                           "calibrate, render"),
             std::string::npos)
       << r.output;
