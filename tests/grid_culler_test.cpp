@@ -211,3 +211,23 @@ TEST(Grid, PrePassOfACellQueriedThisFrameIsConditionalOnItsQueryUnlessAnObjectLe
     EXPECT_EQ(times_drawn(backend, 4), 1u);
   }
 }
+
+TEST(Grid, DrawsNoObjectOutsideTheFrustumThoughACellOfItMeetsTheFrustum) {
+  Stage s;
+  // Object 4: left of the frustum (at z = -3 it spans x -6..-2.5; the view
+  // reaches x = -1.73 there), in a cell (x -3..-1, z -4..-2) that the
+  // frustum meets.
+  const Aabb beside{{-6.0f, 0.0f, -3.0f}, {-2.5f, 1.0f, -2.8f}};
+  s.scene.add_object(s.scene.add_mesh(test::box_mesh(beside)), s.scene.object(0).material, glm::mat4(1.0f),
+                     OccluderClass::never);
+  s.bvh = Bvh::build(s.scene);
+  ASSERT_EQ(s.view.frustum.classify(beside), Containment::outside);
+  test::RecordingBackend backend;
+  auto culler = s.make();
+  for (int frame = 1; frame <= 2; ++frame) {
+    backend.rendered.clear();
+    culler->render_frame(s.view, backend);
+    EXPECT_EQ(times_drawn(backend, 4), 0u) << "frame " << frame;
+    EXPECT_EQ(times_drawn(backend, 0), 1u) << "frame " << frame;
+  }
+}

@@ -136,6 +136,8 @@ class GridCuller final : public Culler {
         for (ObjectId id : grid_.objects(c)) {
           if (drawn_[id] == frame_) continue;
           drawn_[id] = frame_;
+          // The cell meets the frustum; the object may reach it only outside.
+          if (view.frustum.classify(scene_.object(id).bounds) == Containment::outside) continue;
           if (occludes(id, prepass)) {
             (conditional && in_one_cell(id) ? inside_ : prepass_).push_back(id);
             ++prepass;
