@@ -11,6 +11,7 @@
 #include <memory>
 #include <span>
 #include <string>
+#include <initializer_list>
 #include <string_view>
 #include <vector>
 
@@ -43,6 +44,9 @@ class Options {
                                   double hi) const;
   /// Accepts on/off, true/false, yes/no, 1/0.
   [[nodiscard]] bool get_bool(const std::string& key, bool fallback) const;
+  /// One of `choices` (fallback when absent); InputError listing them otherwise.
+  [[nodiscard]] std::string get_choice(const std::string& key, std::string_view fallback,
+                                       std::initializer_list<std::string_view> choices) const;
 
  private:
   std::map<std::string, std::string> values_;

@@ -171,6 +171,18 @@ bool Options::get_bool(const std::string& key, bool fallback) const {
   throw InputError(fmt::format("option {}: '{}' is not on/off", key, it->second));
 }
 
+std::string Options::get_choice(const std::string& key, std::string_view fallback,
+                                std::initializer_list<std::string_view> choices) const {
+  const auto it = values_.find(key);
+  if (it == values_.end()) return std::string(fallback);
+  std::string valid;
+  for (std::string_view c : choices) {
+    if (c == it->second) return it->second;
+    valid += fmt::format("{}{}", valid.empty() ? "" : ", ", c);
+  }
+  throw InputError(fmt::format("option {}: '{}' is not one of {}", key, it->second, valid));
+}
+
 std::span<const AlgorithmInfo> algorithms() {
   static const std::vector<AlgorithmInfo> infos = [] {
     std::vector<AlgorithmInfo> v;

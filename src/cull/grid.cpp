@@ -217,30 +217,18 @@ class GridCuller final : public Culler {
 std::unique_ptr<Culler> make_grid(const SceneIndex& index, const Options& o) {
   GridConfig c;
   c.cell = float(o.get_double("grid.cell", 0.0, 0.0, 1e9));
-  const std::string traversal = o.values().count("grid.traversal") ? o.values().at("grid.traversal") : "frustum";
-  if (traversal == "box")
-    c.traversal = GridTraversal::Mode::box;
-  else if (traversal != "frustum")
-    throw InputError("option grid.traversal: '" + traversal + "' is not one of frustum, box");
+  if (o.get_choice("grid.traversal", "frustum", {"frustum", "box"}) == "box") c.traversal = GridTraversal::Mode::box;
   c.cap = o.get_int("grid.cap", c.cap, 1, 1 << 24);
   c.vis_duration = o.get_int("grid.vis_duration", c.vis_duration, 1, 1 << 16);
   c.vis_growth = o.get_int("grid.vis_growth", c.vis_growth, 0, 1 << 16);
   c.invis_duration = o.get_int("grid.invis_duration", c.invis_duration, 1, 1 << 16);
   c.invis_growth = o.get_int("grid.invis_growth", c.invis_growth, 0, 1 << 16);
   c.prepass = o.get_int("grid.prepass", c.prepass, 0, 1 << 24);
-  const std::string unknown = o.values().count("grid.unknown") ? o.values().at("grid.unknown") : "visible";
-  if (unknown != "visible" && unknown != "hidden")
-    throw InputError("option grid.unknown: '" + unknown + "' is not one of visible, hidden");
-  c.unknown_visible = unknown == "visible";
+  c.unknown_visible = o.get_choice("grid.unknown", "visible", {"visible", "hidden"}) == "visible";
   c.tight = o.get_bool("grid.tight", c.tight);
-  const std::string conditional =
-      o.values().count("grid.conditional") ? o.values().at("grid.conditional") : "wait";
-  if (conditional == "off")
-    c.conditional.reset();
-  else if (conditional == "wait" || conditional == "no_wait")
-    c.conditional = conditional == "wait" ? ConditionalWait::wait : ConditionalWait::no_wait;
-  else
-    throw InputError("option grid.conditional: '" + conditional + "' is not one of wait, no_wait, off");
+  const std::string conditional = o.get_choice("grid.conditional", "wait", {"wait", "no_wait", "off"});
+  if (conditional == "off") c.conditional.reset();
+  if (conditional == "no_wait") c.conditional = ConditionalWait::no_wait;
   c.threshold = std::uint64_t(o.get_int("grid.threshold", 0, 0, 1 << 24));
   c.seed = std::uint32_t(o.get_int("grid.seed", 1, 0, 1 << 30));
   return std::make_unique<GridCuller>(index, c);
