@@ -1,7 +1,9 @@
 // `grid` (seed 003's uniform-grid culling) against a Backend test double
 // whose answers the test controls.
 #include "occull/culler.hpp"
+#include "occull/error.hpp"
 #include "occull/grid.hpp"
+#include "occull/grid_views.hpp"
 #include "test_util.hpp"
 
 #include <gtest/gtest.h>
@@ -230,4 +232,63 @@ TEST(Grid, DrawsNoObjectOutsideTheFrustumThoughACellOfItMeetsTheFrustum) {
     EXPECT_EQ(times_drawn(backend, 4), 0u) << "frame " << frame;
     EXPECT_EQ(times_drawn(backend, 0), 1u) << "frame " << frame;
   }
+}
+
+TEST(QueryBudget, SplitsEvenlyFirstThenGrantsDemandsThatFitAndSharesTheSlack) {
+  QueryBudget b(100, 2);
+  EXPECT_EQ(b.allowance(0), 50);
+  EXPECT_EQ(b.allowance(1), 50);
+  b.report(0, 30, 10, 0);
+  b.report(1, 15, 0, 5);
+  b.split();
+  EXPECT_EQ(b.allowance(0), 30 + 25);
+  EXPECT_EQ(b.allowance(1), 20 + 25);
+}
+
+TEST(QueryBudget, OverTheCapAViewWhoseQueriesCullGetsMoreThanOneWhoseQueriesDoNot) {
+  QueryBudget b(100, 2, 0.25);
+  for (int frame = 0; frame < 12; ++frame) {
+    b.report(0, 150, 120, 50);  // 80 % of its queries find a hidden cell
+    b.report(1, 150, 0, 50);    // none of its queries culls anything
+    b.split();
+  }
+  EXPECT_GT(b.benefit(0), 0.7);
+  EXPECT_LT(b.benefit(1), 0.1);
+  EXPECT_LE(b.allowance(0) + b.allowance(1), 100);
+  EXPECT_GT(b.allowance(0), 3 * b.allowance(1));
+  EXPECT_GE(b.allowance(1), 12) << "the floor: a quarter of an even share";
+  // Equal demand and benefit: an even split.
+  QueryBudget even(100, 2);
+  even.report(0, 150, 75, 50);
+  even.report(1, 150, 75, 50);
+  even.split();
+  EXPECT_EQ(even.allowance(0), even.allowance(1));
+  EXPECT_THROW(QueryBudget(1, 2), InputError);
+}
+
+TEST(GridViews, ViewsShareOneGridAndTheViewWhoseQueriesCullGetsTheLargerShare) {
+  Stage s;
+  // View 1 stands left of the wall looking down -X: it sees object 3 in the open.
+  const View left = make_view({{-10, 1, -10.5f}, 1.5707963f, 0}, {60.0f, 0.5f, 100.0f}, 64, 64);
+  Options o;
+  o.set("grid.cell=2");
+  o.set("grid.cap=8");
+  test::RecordingBackend front, side;  // outlive the views, which read their last queries on destruction
+  front.visible_samples = behind_wall;
+  GridViews views({s.scene, s.bvh}, 2, o);
+  EXPECT_EQ(views.grid().occupied(), UniformGrid::of_scene(s.scene, 2.0f).occupied());
+  for (int frame = 1; frame <= 8; ++frame) {
+    views.begin_frame();
+    front.rendered.clear();
+    side.rendered.clear();
+    views.view(0).render_frame(s.view, front);
+    views.view(1).render_frame(left, side);
+    EXPECT_EQ(times_drawn(front, 0), 1u) << "frame " << frame;
+    EXPECT_EQ(times_drawn(front, 3), 0u) << "frame " << frame;
+    EXPECT_EQ(times_drawn(side, 3), 1u) << "frame " << frame;
+    EXPECT_EQ(times_drawn(side, 0), 0u) << "frame " << frame;
+  }
+  EXPECT_GT(views.budget().benefit(0), views.budget().benefit(1));
+  EXPECT_GT(views.budget().allowance(0), views.budget().allowance(1));
+  EXPECT_LE(views.budget().allowance(0) + views.budget().allowance(1), 8);
 }

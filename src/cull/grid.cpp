@@ -41,7 +41,12 @@
 
 #include "occull/error.hpp"
 #include "occull/grid.hpp"
+#include "occull/grid_views.hpp"
 
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <memory>
 #include <optional>
 #include <random>
 
@@ -64,8 +69,11 @@ struct GridConfig {
 
 class GridCuller final : public Culler {
  public:
-  GridCuller(const SceneIndex& index, const GridConfig& config)
-      : scene_(index.scene), config_(config), grid_(UniformGrid::of_scene(index.scene, config.cell)),
+  // `grid` and `budget` may be shared with the cullers of other views
+  // (GridViews); without a budget the cap is config.cap.
+  GridCuller(const SceneIndex& index, const GridConfig& config, std::shared_ptr<UniformGrid> grid,
+             std::shared_ptr<QueryBudget> budget = nullptr, int view = 0)
+      : scene_(index.scene), config_(config), grid_(std::move(grid)), budget_(std::move(budget)), view_(view),
         drawn_(index.scene.objects().size(), ~std::uint64_t(0)), rng_(config.seed) {}
 
   ~GridCuller() override {
@@ -76,25 +84,26 @@ class GridCuller final : public Culler {
   FrameStats render_frame(const View& view, Backend& backend) override {
     FrameStats stats;
     backend_ = &backend;
-    for (ObjectId id : scene_.dynamic_objects()) grid_.update(id, scene_.object(id).bounds);
-    if (cells_.size() < grid_.occupied()) cells_.resize(grid_.occupied());
+    for (ObjectId id : scene_.dynamic_objects()) grid_->update(id, scene_.object(id).bounds);
+    if (cells_.size() < grid_->occupied()) cells_.resize(grid_->occupied());
     gather(backend);
     ++frame_;
 
     const float near_radius = near_plane_radius(view);
+    const int cap = budget_ ? budget_->allowance(view_) : config_.cap;
     int queries = 0, prepass = 0;
     bool capped = false;
     std::uint64_t answers = 0, age = 0;
     colour_.clear();
-    for (const CellRun& run : traversal_.traverse(grid_.geometry(), view, config_.traversal)) {
+    for (const CellRun& run : traversal_.traverse(grid_->geometry(), view, config_.traversal)) {
       for (int i = 0; i < run.count; ++i) {
         ++stats.nodes_visited;
-        const std::uint32_t c = grid_.find(run.start + run.step * i);
-        if (c == UniformGrid::kNoCell || grid_.objects(c).empty()) continue;
+        const std::uint32_t c = grid_->find(run.start + run.step * i);
+        if (c == UniformGrid::kNoCell || grid_->objects(c).empty()) continue;
         Cell& cell = cells_[c];
         const bool seen_last_frame = cell.seen + 1 == frame_;
         cell.seen = frame_;
-        const Aabb box = config_.tight ? grid_.content_box(c) : grid_.geometry().cell_box(grid_.coord(c));
+        const Aabb box = config_.tight ? grid_->content_box(c) : grid_->geometry().cell_box(grid_->coord(c));
         bool draw = cell.visible && cell.until >= frame_;
         bool requery = cell.until <= frame_;
         const bool unknown = !seen_last_frame && !draw;
@@ -112,11 +121,11 @@ class GridCuller final : public Culler {
         QueryId query = 0;
         bool queried = false;
         if (requery) {
-          if (queries >= config_.cap && !capped) {
+          if (queries >= cap && !capped) {
             capped = true;
             ++capped_frames_;
           }
-          if (queries < config_.cap || draw) {
+          if (queries < cap || draw) {
             query = backend.issue_query(std::span<const Aabb>(&box, 1));
             queried = true;
             pending_.push_back({query, c});
@@ -133,7 +142,7 @@ class GridCuller final : public Culler {
         const bool conditional = queried && config_.conditional && backend.conditional_rendering();
         prepass_.clear();
         inside_.clear();
-        for (ObjectId id : grid_.objects(c)) {
+        for (ObjectId id : grid_->objects(c)) {
           if (drawn_[id] == frame_) continue;
           drawn_[id] = frame_;
           // The cell meets the frustum; the object may reach it only outside.
@@ -151,6 +160,7 @@ class GridCuller final : public Culler {
     }
     if (!capped) capped_frames_ = 0;
     stats.capped = capped ? 1 : 0;
+    deferred_ = stats.over_cap;
     stats.result_age = answers > 0 ? double(age) / double(answers) : 0.0;
     backend.flush();  // the queries run while the colour pass is drawn
     if (!colour_.empty()) backend.render(colour_);
@@ -174,20 +184,23 @@ class GridCuller final : public Culler {
   void gather(Backend& backend) {
     const int grow = capped_frames_;
     std::uniform_int_distribution<int> offset(0, 2 * grow);
+    std::uint64_t hidden = 0;
     for (const Pending& p : pending_) {
       Cell& cell = cells_[p.cell];
       cell.visible = backend.result(p.query) > config_.threshold;
+      hidden += cell.visible ? 0 : 1;
       cell.asked = frame_;
       const int base = cell.visible ? config_.vis_duration + config_.vis_growth * grow
                                     : config_.invis_duration + config_.invis_growth * grow;
       cell.until = frame_ + std::uint64_t(base) + std::uint64_t(grow > 0 ? offset(rng_) : 0);
     }
+    if (budget_) budget_->report(view_, pending_.size(), hidden, deferred_);
     pending_.clear();
   }
 
   bool in_one_cell(ObjectId id) const {
     const Aabb& b = scene_.object(id).bounds;
-    return grid_.geometry().cell_of(b.min) == grid_.geometry().cell_of(b.max);
+    return grid_->geometry().cell_of(b.min) == grid_->geometry().cell_of(b.max);
   }
 
   // Whether object `id` goes to the pre-pass, given `drawn` pre-pass objects so far.
@@ -200,7 +213,10 @@ class GridCuller final : public Culler {
 
   const Scene& scene_;
   GridConfig config_;
-  UniformGrid grid_;
+  std::shared_ptr<UniformGrid> grid_;
+  std::shared_ptr<QueryBudget> budget_;
+  int view_;
+  std::uint64_t deferred_ = 0;          // queries the cap deferred in the last frame
   GridTraversal traversal_;
   std::vector<Cell> cells_;             // per occupied cell
   std::vector<std::uint64_t> drawn_;    // per object: last frame it was drawn (once per frame)
@@ -214,7 +230,9 @@ class GridCuller final : public Culler {
 
 }  // namespace
 
-std::unique_ptr<Culler> make_grid(const SceneIndex& index, const Options& o) {
+namespace {
+
+GridConfig grid_config(const Options& o) {
   GridConfig c;
   c.cell = float(o.get_double("grid.cell", 0.0, 0.0, 1e9));
   if (o.get_choice("grid.traversal", "frustum", {"frustum", "box"}) == "box") c.traversal = GridTraversal::Mode::box;
@@ -231,7 +249,91 @@ std::unique_ptr<Culler> make_grid(const SceneIndex& index, const Options& o) {
   if (conditional == "no_wait") c.conditional = ConditionalWait::no_wait;
   c.threshold = std::uint64_t(o.get_int("grid.threshold", 0, 0, 1 << 24));
   c.seed = std::uint32_t(o.get_int("grid.seed", 1, 0, 1 << 30));
-  return std::make_unique<GridCuller>(index, c);
+  return c;
+}
+
+}  // namespace
+
+std::unique_ptr<Culler> make_grid(const SceneIndex& index, const Options& o) {
+  const GridConfig c = grid_config(o);
+  return std::make_unique<GridCuller>(index, c, std::make_shared<UniformGrid>(UniformGrid::of_scene(index.scene, c.cell)));
 }
 
 }  // namespace occull::detail
+
+namespace occull {
+
+QueryBudget::QueryBudget(int total, int views, double floor)
+    : total_(total), floor_(floor), allowance_(std::size_t(views)), benefit_(std::size_t(views), 1.0),
+      demand_(std::size_t(views), 0) {
+  if (views < 1 || total < views || !(floor >= 0.0 && floor <= 1.0))
+    throw InputError(fmt::format("query budget: {} queries for {} views (floor {}) cannot be split", total, views,
+                                 floor));
+  for (int& a : allowance_) a = total / views;
+}
+
+void QueryBudget::report(int view, std::uint64_t issued, std::uint64_t hidden, std::uint64_t deferred) {
+  const std::size_t k = std::size_t(view);
+  demand_.at(k) = issued + deferred;
+  if (issued == 0) return;
+  const double share = double(std::min(hidden, issued)) / double(issued);
+  benefit_[k] = std::max(0.01, 0.75 * benefit_[k] + 0.25 * share);
+}
+
+void QueryBudget::split() {
+  const std::size_t n = allowance_.size();
+  std::uint64_t wanted = 0;
+  for (std::uint64_t d : demand_) wanted += d;
+  if (wanted <= std::uint64_t(total_)) {
+    // Everyone gets what it asked for; the slack is shared evenly.
+    const std::uint64_t slack = (std::uint64_t(total_) - wanted) / n;
+    for (std::size_t k = 0; k < n; ++k) allowance_[k] = int(demand_[k] + slack);
+  } else {
+    // A floor each, then the rest by demand x benefit, capped at the remaining demand.
+    const auto floor_each = std::uint64_t(floor_ * double(total_) / double(n));
+    std::vector<std::uint64_t> grant(n), rest(n);
+    std::uint64_t left = std::uint64_t(total_);
+    for (std::size_t k = 0; k < n; ++k) {
+      grant[k] = std::min(demand_[k], floor_each);
+      rest[k] = demand_[k] - grant[k];
+      left -= grant[k];
+    }
+    // Proportional shares; a view that needs less than its share passes the remainder on.
+    for (int round = 0; round < int(n) && left > 0; ++round) {
+      double weight = 0.0;
+      for (std::size_t k = 0; k < n; ++k)
+        if (rest[k] > 0) weight += double(rest[k]) * benefit_[k];
+      if (weight <= 0.0) break;
+      std::uint64_t given = 0;
+      for (std::size_t k = 0; k < n; ++k) {
+        if (rest[k] == 0) continue;
+        const auto share = std::uint64_t(double(left) * double(rest[k]) * benefit_[k] / weight);
+        const std::uint64_t g = std::min(rest[k], share);
+        grant[k] += g;
+        rest[k] -= g;
+        given += g;
+      }
+      left -= given;
+      if (given == 0) break;
+    }
+    for (std::size_t k = 0; k < n; ++k) allowance_[k] = int(grant[k]);
+  }
+  for (int& a : allowance_) a = std::max(a, 1);
+}
+
+GridViews::GridViews(const SceneIndex& index, int views, const Options& options, double floor) {
+  if (views < 1 || views > 16) throw InputError(fmt::format("{} views: must be in [1, 16]", views));
+  check_options(options);
+  const detail::GridConfig c = detail::grid_config(options);
+  grid_ = std::make_shared<UniformGrid>(UniformGrid::of_scene(index.scene, c.cell));
+  budget_ = std::make_shared<QueryBudget>(std::max(c.cap, views), views, floor);
+  for (int k = 0; k < views; ++k) {
+    detail::GridConfig view_config = c;
+    view_config.seed = c.seed + std::uint32_t(k);
+    views_.push_back(std::make_unique<detail::GridCuller>(index, view_config, grid_, budget_, k));
+  }
+}
+
+GridViews::~GridViews() = default;
+
+}  // namespace occull
