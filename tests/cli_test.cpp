@@ -60,7 +60,7 @@ TEST(Cli, HelpOnEveryCommandNamesItsOptions) {
       {"path", {"--scene", "--path", "--out"}},
       {"bench", {"--scene", "--path", "--algo", "--frames", "--fps", "--start", "--size", "--query-mode",
                  "--query-raster", "--query-margin", "--draw", "--verify", "--repeat", "--model", "--json",
-                 "--suite", "--malloc"}},
+                 "--suite", "--malloc", "--views"}},
       {"calibrate", {"--size", "--repeats", "--out", "--check"}},
       {"sweep", {"--algo", "--vary", "--baseline", "--popping", "--longest", "--scene", "--frames", "--json"}},
       {"render", {"--scene", "--frame", "--fps", "--out"}}};
@@ -491,4 +491,16 @@ TEST(Cli, SweepOfAnUnknownOptionListsTheValidOnes) {
   EXPECT_NE(r.output.find("valid options: cell, traversal, cap"), std::string::npos) << r.output;
   const CliRun two = run("sweep --algo grid,vfc --vary cap=1");
   EXPECT_EQ(two.code, 2) << two.output;
+}
+
+TEST(Cli, SplitScreenBenchNamesBothPathsAndAPathListNeedsViews) {
+  const CliRun r = run("bench --scene city:blocks=3,traffic=3 --size 128x48 --views 2 --path street,turn "
+                       "--algo vfc,grid --frames 2 --warmup 0 --no-report");
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("path street | turn"), std::string::npos) << r.output;
+  EXPECT_FALSE(table_row(r.output, "grid").empty()) << r.output;
+  EXPECT_NE(r.output.find("\ngrid [view 2] "), std::string::npos) << r.output;
+  const CliRun list = run("bench --path street,turn --frames 1");
+  EXPECT_EQ(list.code, 2) << list.output;
+  EXPECT_NE(list.output.find("needs --views"), std::string::npos) << list.output;
 }

@@ -352,3 +352,42 @@ TEST(Report, JsonCarriesEveryDocumentedField) {
   }
   EXPECT_TRUE(std::filesystem::exists(dir + "/report.md"));
 }
+
+TEST(Bench, SplitScreenRunsEachViewOnItsPathAndReportsTheFrameAndEachView) {
+  BenchConfig c;
+  c.scene = kSmallCity;
+  c.views = 2;
+  c.view_paths = {"street", "turn"};
+  c.algorithms = {"vfc", "grid", "oracle"};
+  c.frames = 3;
+  c.warmup = 1;
+  c.width = 128;
+  c.height = 54;
+  const BenchResult r = run_bench(c);
+  EXPECT_EQ(r.path, "street | turn");
+  std::vector<std::string> names;
+  for (const AlgorithmSummary& a : r.summaries) names.push_back(a.name);
+  EXPECT_EQ(names, (std::vector<std::string>{"vfc", "vfc [view 1]", "vfc [view 2]", "grid", "grid [view 1]",
+                                             "grid [view 2]", "oracle", "oracle [view 1]", "oracle [view 2]"}));
+  EXPECT_TRUE(verification_failures(r).empty());
+  // A frame's figures are the sums of its views'.
+  for (std::size_t run = 0; run < r.runs.size(); run += 3) {
+    const AlgorithmRun &whole = r.runs[run], &a = r.runs[run + 1], &b = r.runs[run + 2];
+    ASSERT_EQ(whole.frames.size(), 3u);
+    for (std::size_t f = 0; f < 3; ++f) {
+      EXPECT_DOUBLE_EQ(whole.frames[f].frame_ms, a.frames[f].frame_ms + b.frames[f].frame_ms);
+      EXPECT_EQ(whole.frames[f].objects_rendered, a.frames[f].objects_rendered + b.frames[f].objects_rendered);
+      EXPECT_EQ(whole.frames[f].truth_objects, a.frames[f].truth_objects + b.frames[f].truth_objects);
+    }
+  }
+  // The two views look at different things: their truths differ somewhere.
+  bool differ = false;
+  for (std::size_t f = 0; f < 3; ++f) differ = differ || r.runs[7].frames[f].objects_rendered != r.runs[8].frames[f].objects_rendered;
+  EXPECT_TRUE(differ) << "the oracle of view 1 and view 2 drew the same in every frame";
+  // Each view compares with the same view of vfc.
+  EXPECT_DOUBLE_EQ(r.summaries[1].ratio_to_vfc, 1.0);
+  EXPECT_DOUBLE_EQ(r.summaries[2].ratio_to_vfc, 1.0);
+  EXPECT_DOUBLE_EQ(r.summaries[0].ratio_to_vfc, 1.0);
+  c.views = 9;
+  EXPECT_THROW((void)run_bench(c), InputError);
+}

@@ -215,6 +215,7 @@ struct BenchArgs {
   bool model = false;
   std::string malloc_policy = "engine";
   std::string suite;
+  int views = 1;
 };
 
 bool parse_on_off(const std::string& flag, const std::string& s) {
@@ -305,7 +306,13 @@ occull::BenchConfig bench_config(const BenchArgs& a) {
   occull::BenchConfig c;
   c.allocator = occull::apply_allocator_policy(occull::parse_allocator_policy(a.malloc_policy));
   c.scene = a.scene;
-  c.path = a.path;
+  c.views = a.views;
+  if (a.views > 1)
+    c.view_paths = split_list(a.path);
+  else if (a.path.find(',') != std::string::npos)
+    throw occull::InputError(fmt::format("--path {}: one path per view needs --views", a.path));
+  else
+    c.path = a.path;
   c.algorithms = split_list(a.algos);
   c.frames = a.frames;
   c.warmup = a.warmup;
@@ -563,6 +570,10 @@ int main(int argc, char** argv) {
   b->add_flag("--model", bench.model,
               "also predict every frame with the NOHC cost model and print predicted vs measured");
   b->add_option("--bvh-leaf", bench.bvh_leaf, "most objects in a BVH leaf (binned SAH decides below that)")
+      ->capture_default_str();
+  b->add_option("--views", bench.views,
+                "split screen: this many views side by side (each WIDTH/N wide), one path each (--path A,B; "
+                "default: the scene's paths in turn); grid shares one grid and query cap between them")
       ->capture_default_str();
   b->add_option("--draw", bench.draw,
                 "object submission: single (one draw per object) or multi (one multi-draw per material run)")

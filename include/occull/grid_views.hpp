@@ -65,9 +65,10 @@ class QueryBudget {
 class GridViews {
  public:
   /// A `grid` culler per view, with `options` (grid.*; grid.cap is the
-  /// total of all views). Preconditions: index.scene outlives this object;
-  /// 1 <= views <= 16. Throws InputError for a bad option.
-  GridViews(const SceneIndex& index, int views, const Options& options = {}, double floor = 0.25);
+  /// total of all views, grid.split_floor the QueryBudget's floor).
+  /// Preconditions: index.scene outlives this object; 1 <= views <= 16.
+  /// Throws InputError for a bad option.
+  GridViews(const SceneIndex& index, int views, const Options& options = {});
   ~GridViews();
   GridViews(const GridViews&) = delete;
   GridViews& operator=(const GridViews&) = delete;

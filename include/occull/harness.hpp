@@ -74,6 +74,21 @@ struct AlgorithmRun {
   std::uint32_t longest_miss_frames = 0;  ///< longest run of frames one object stayed missed
 };
 
+/// How long objects stay missed over consecutive frames of one run.
+class MissRuns {
+ public:
+  explicit MissRuns(std::size_t objects) : run_(objects, 0) {}
+  /// The missed ids of the next frame (ascending, as check_frame returns them).
+  void add(const std::vector<ObjectId>& missed);
+  /// Longest run of consecutive frames one object stayed missed so far.
+  [[nodiscard]] std::uint32_t longest() const noexcept { return longest_; }
+
+ private:
+  std::vector<std::uint32_t> run_;
+  std::vector<ObjectId> previous_;
+  std::uint32_t longest_ = 0;
+};
+
 /// Fault injection, for tests only: each hook, when set, may corrupt one
 /// step of the instrument, so a test can see the run-time invariant that
 /// guards that step stop the run (a check never seen failing is not trusted).
@@ -141,6 +156,13 @@ class Session {
   FrameStats run_path_frame(Culler& culler, const CameraPath& path, int k, int frames,
                             const std::vector<FrameTruth>* truth);
 
+  /// Checks the frame `culler` just ran (frame k of `path`) against its
+  /// truth, outside the timed region: frame-within-truth, and
+  /// oracle-draws-truth for the oracle (throw InvariantViolation); fills
+  /// the verification figures of `stats` and returns the missed ids.
+  std::vector<ObjectId> verify_frame(std::string_view name, const Culler& culler, const CameraPath& path, int k,
+                                     const FrameTruth& truth, FrameStats& stats);
+
   /// With `predict`, also fills FrameStats::model_ms (see predicted_frame_ms).
   /// With `truth`, checks every frame against it (frame-within-truth, and
   /// oracle-draws-truth for the oracle); throws InvariantViolation.
@@ -203,6 +225,13 @@ class Session {
 struct BenchConfig {
   std::string scene = "city";             ///< scene spec, see make_scene()
   std::string path;                       ///< camera path; empty = the scene's first
+  /// Split screen: this many views side by side, each width/views x height,
+  /// each on its own path (view_paths, else the scene's paths in turn),
+  /// rendered one after the other in every frame with a culler each (grid:
+  /// one GridViews sharing its grid and query cap). A frame's figures are
+  /// the sums over the views; runs named "ALGO [view K]" hold each view's.
+  int views = 1;
+  std::vector<std::string> view_paths;    ///< with views > 1: the path of each view (empty: the scene's)
   std::vector<std::string> algorithms;    ///< specs (see parse_algorithm_spec); empty = every algorithm
   int frames = 100;                       ///< timed frames per algorithm and repeat, >= 1
   FrameSampling sampling;                 ///< where they lie on the path (default: spread over it)

@@ -93,7 +93,8 @@ const std::vector<Entry>& registry() {
          {"tight", "on", "query the box of what a cell holds instead of the whole cell"},
          {"conditional", "wait", "pre-pass of a cell queried this frame under conditional rendering on its query: wait (the device waits for the result), no_wait (draws while it is unknown) or off"},
          {"threshold", "0", "a cell is visible when more samples (pixels) pass"},
-         {"seed", "1", "random seed of the answers' extra duration when capped"}}},
+         {"seed", "1", "random seed of the answers' extra duration when capped"},
+         {"split_floor", "0.25", "split screen (bench --views): share of an even split of the cap each view is sure of; the rest goes by demand x share of queries that find cells hidden (1: an even split)"}}},
        &detail::make_grid},
       {{"auto",
         "adaptive: runs the cheapest of chcpp, vfc and nohc for this view, learnt from the measured frame times, "

@@ -321,11 +321,12 @@ void QueryBudget::split() {
   for (int& a : allowance_) a = std::max(a, 1);
 }
 
-GridViews::GridViews(const SceneIndex& index, int views, const Options& options, double floor) {
+GridViews::GridViews(const SceneIndex& index, int views, const Options& options) {
   if (views < 1 || views > 16) throw InputError(fmt::format("{} views: must be in [1, 16]", views));
   check_options(options);
   const detail::GridConfig c = detail::grid_config(options);
   grid_ = std::make_shared<UniformGrid>(UniformGrid::of_scene(index.scene, c.cell));
+  const double floor = options.get_double("grid.split_floor", 0.25, 0.0, 1.0);
   budget_ = std::make_shared<QueryBudget>(std::max(c.cap, views), views, floor);
   for (int k = 0; k < views; ++k) {
     detail::GridConfig view_config = c;

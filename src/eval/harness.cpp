@@ -1,4 +1,5 @@
 #include "occull/harness.hpp"
+#include "occull/grid_views.hpp"
 
 #include "occull/error.hpp"
 #include "occull/gl/calibrate.hpp"
@@ -283,33 +284,36 @@ AlgorithmRun Session::run_path(std::string_view name, Culler& culler, const Came
                                const ProgressFn& progress, bool predict) {
   AlgorithmRun run{std::string(name), 0, true, {}, 0};
   run.frames.reserve(std::size_t(frames));
-  std::vector<std::uint32_t> miss_run(bundle_.scene.objects().size(), 0);
-  std::vector<ObjectId> previously_missed;
+  MissRuns misses(bundle_.scene.objects().size());
   for (int k = 0; k < frames; ++k) {
     FrameStats s = run_path_frame(culler, path, k, frames, truth);
     if (predict) s.model_ms = predicted_frame_ms(view_at(path, k, frames));
-    if (truth) {
-      // Outside the timed region: compare what was rendered with the truth.
-      const FrameTruth& t = (*truth)[std::size_t(k)];
-      const detail::FrameLabel where{scene_spec_, path.name(), k};
-      std::vector<float> depth = renderer_->read_depth();
-      if (hooks_.frame_depth) hooks_.frame_depth(depth);
-      const Coverage frame = detail::depth_coverage(depth);
-      detail::check_frame_within_truth(where, std::string(name), t.coverage, frame);
-      if (dynamic_cast<const detail::OracleCuller*>(&culler))
-        detail::check_oracle_draws_truth(where, t.visible, renderer_->frame_objects(), t.coverage.depth_hash,
-                                         frame.depth_hash);
-      const std::vector<ObjectId> missed =
-          check_frame(t.visible, renderer_->frame_objects(), bundle_.scene.objects().size(), s);
-      for (ObjectId id : previously_missed)
-        if (!std::binary_search(missed.begin(), missed.end(), id)) miss_run[id] = 0;
-      for (ObjectId id : missed) run.longest_miss_frames = std::max(run.longest_miss_frames, ++miss_run[id]);
-      previously_missed = missed;
-    }
+    if (truth) misses.add(verify_frame(name, culler, path, k, (*truth)[std::size_t(k)], s));
     run.frames.push_back(s);
     if (progress) progress(name, k, frames, false);
   }
+  run.longest_miss_frames = misses.longest();
   return run;
+}
+
+std::vector<ObjectId> Session::verify_frame(std::string_view name, const Culler& culler, const CameraPath& path,
+                                            int k, const FrameTruth& t, FrameStats& s) {
+  const detail::FrameLabel where{scene_spec_, path.name(), k};
+  std::vector<float> depth = renderer_->read_depth();
+  if (hooks_.frame_depth) hooks_.frame_depth(depth);
+  const Coverage frame = detail::depth_coverage(depth);
+  detail::check_frame_within_truth(where, std::string(name), t.coverage, frame);
+  if (dynamic_cast<const detail::OracleCuller*>(&culler))
+    detail::check_oracle_draws_truth(where, t.visible, renderer_->frame_objects(), t.coverage.depth_hash,
+                                     frame.depth_hash);
+  return check_frame(t.visible, renderer_->frame_objects(), bundle_.scene.objects().size(), s);
+}
+
+void MissRuns::add(const std::vector<ObjectId>& missed) {
+  for (ObjectId id : previous_)
+    if (!std::binary_search(missed.begin(), missed.end(), id)) run_[id] = 0;
+  for (ObjectId id : missed) longest_ = std::max(longest_, ++run_[id]);
+  previous_ = missed;
 }
 
 Summary summarize(std::vector<double> v) {
@@ -390,8 +394,11 @@ std::vector<AlgorithmSummary> summarize_runs(std::span<const AlgorithmRun> runs)
       per_repeat["max"].push_back(s.max);
       for (const auto& [key, sum] : sums) per_repeat[key].push_back(sum / n);
       if (sums["nodes_visited"] > 0) per_repeat["cpu_us_per_node"].push_back(1e3 * sums["cpu_ms"] / sums["nodes_visited"]);
+      // A view of a split-screen run compares with the same view of the baseline.
+      const std::size_t view_at = r.name.find(" [view ");
+      const std::string view = view_at == std::string::npos ? "" : r.name.substr(view_at);
       const auto ratio = [&](const char* base, const char* key) {
-        const auto it = mean_ms.find({r.repeat, base});
+        const auto it = mean_ms.find({r.repeat, base + view});
         if (it != mean_ms.end() && it->second > 0) per_repeat[key].push_back(s.mean / it->second);
       };
       ratio("vfc", "ratio_to_vfc");
@@ -449,6 +456,116 @@ std::vector<const AlgorithmSummary*> verification_failures(const BenchResult& re
   return failed;
 }
 
+namespace {
+
+// Adds one view's figures of a split-screen frame to the frame's.
+void add_view(FrameStats& sum, const FrameStats& v) {
+  sum.frame_ms += v.frame_ms;
+  sum.cpu_ms += v.cpu_ms;
+  sum.wait_ms += v.wait_ms;
+  sum.gpu_ms += v.gpu_ms;
+  sum.model_ms += v.model_ms;
+  sum.kernel_ms += v.kernel_ms;
+  sum.minor_faults += v.minor_faults;
+  sum.major_faults += v.major_faults;
+  sum.nodes_visited += v.nodes_visited;
+  sum.multiqueries += v.multiqueries;
+  sum.failed_multiqueries += v.failed_multiqueries;
+  sum.query_batches += v.query_batches;
+  sum.capped = std::max(sum.capped, v.capped);
+  sum.over_cap += v.over_cap;
+  sum.result_age += v.result_age;  // divided by the views at the end
+  sum.queries += v.queries;
+  sum.query_boxes += v.query_boxes;
+  sum.state_changes += v.state_changes;
+  sum.blocking_waits += v.blocking_waits;
+  sum.flushes += v.flushes;
+  sum.material_changes += v.material_changes;
+  sum.render_flushes += v.render_flushes;
+  sum.draw_calls += v.draw_calls;
+  sum.triangles += v.triangles;
+  sum.objects_rendered += v.objects_rendered;
+  sum.conditional_objects += v.conditional_objects;
+  sum.conditional_skipped += v.conditional_skipped;
+  sum.truth_objects += v.truth_objects;
+  sum.missed_objects += v.missed_objects;
+  sum.wrong_pixels += v.wrong_pixels;
+  sum.extra_objects += v.extra_objects;
+}
+
+// The cullers of the views of one split-screen run: `grid` shares its grid
+// and query cap between them (GridViews); any other algorithm runs one
+// independent culler per view.
+struct ViewCullers {
+  std::unique_ptr<GridViews> grid;
+  std::vector<std::unique_ptr<Culler>> own;
+
+  ViewCullers(Session& session, const std::string& name, const Options& options, int views) {
+    const AlgorithmSpec spec = parse_algorithm_spec(name, options);
+    if (spec.name == "grid")
+      grid = std::make_unique<GridViews>(session.index(), views, spec.options);
+    else
+      for (int k = 0; k < views; ++k) own.push_back(session.make(name, options));
+  }
+  Culler& view(int k) { return grid ? grid->view(k) : *own.at(std::size_t(k)); }
+  void begin_frame() {
+    if (grid) grid->begin_frame();
+  }
+};
+
+// One algorithm over a split-screen frame sequence: the views render one
+// after the other in each frame. Appends the run of the whole frames, then
+// one run per view ("NAME [view K]").
+void run_split_screen(Session& session, const std::string& name, const BenchConfig& config,
+                      const std::vector<const CameraPath*>& paths, const std::vector<std::vector<FrameTruth>>& truths,
+                      int rep, const std::string& label, const ProgressFn& progress, std::vector<AlgorithmRun>& out) {
+  const int views = int(paths.size());
+  const auto truth_of = [&](int k) { return config.verify ? &truths[std::size_t(k)] : nullptr; };
+  {
+    ViewCullers warm(session, name, config.options, views);
+    for (int w = 0; w < config.warmup; ++w) {
+      const int f = config.warmup > 1 ? w * (config.frames - 1) / (config.warmup - 1) : 0;
+      warm.begin_frame();
+      for (int k = 0; k < views; ++k)
+        (void)session.run_path_frame(warm.view(k), *paths[std::size_t(k)], f, config.frames, truth_of(k));
+      if (progress) progress(label, w, config.warmup, true);
+    }
+  }
+  const bool conservative = is_conservative(parse_algorithm_spec(name, config.options));
+  ViewCullers cullers(session, name, config.options, views);
+  AlgorithmRun whole{name, rep, conservative, {}, 0};
+  std::vector<AlgorithmRun> each;
+  std::vector<MissRuns> misses;
+  for (int k = 0; k < views; ++k) {
+    each.push_back({fmt::format("{} [view {}]", name, k + 1), rep, conservative, {}, 0});
+    misses.emplace_back(session.bundle().scene.objects().size());
+  }
+  for (int f = 0; f < config.frames; ++f) {
+    cullers.begin_frame();
+    FrameStats sum;
+    for (int k = 0; k < views; ++k) {
+      const CameraPath& path = *paths[std::size_t(k)];
+      FrameStats s = session.run_path_frame(cullers.view(k), path, f, config.frames, truth_of(k));
+      if (config.verify)
+        misses[std::size_t(k)].add(session.verify_frame(each[std::size_t(k)].name, cullers.view(k), path, f,
+                                                        truths[std::size_t(k)][std::size_t(f)], s));
+      add_view(sum, s);
+      each[std::size_t(k)].frames.push_back(s);
+    }
+    sum.result_age /= double(views);
+    whole.frames.push_back(sum);
+    if (progress) progress(label, f, config.frames, false);
+  }
+  for (int k = 0; k < views; ++k) {
+    each[std::size_t(k)].longest_miss_frames = misses[std::size_t(k)].longest();
+    whole.longest_miss_frames = std::max(whole.longest_miss_frames, misses[std::size_t(k)].longest());
+  }
+  out.push_back(std::move(whole));
+  for (AlgorithmRun& r : each) out.push_back(std::move(r));
+}
+
+}  // namespace
+
 BenchResult run_bench(const BenchConfig& config, const ProgressFn& progress) {
   if (config.frames < 1) throw InputError(fmt::format("--frames {}: must be at least 1", config.frames));
   if (config.warmup < 0) throw InputError(fmt::format("--warmup {}: must not be negative", config.warmup));
@@ -463,8 +580,14 @@ BenchResult run_bench(const BenchConfig& config, const ProgressFn& progress) {
   }
   check_options(config.options);
 
+  if (config.views < 1 || config.views > 8)
+    throw InputError(fmt::format("--views {}: must be in [1, 8]", config.views));
+  if (config.model && config.views > 1) throw InputError("--model predicts one view: drop it or --views");
+  if (config.width / config.views < 16)
+    throw InputError(fmt::format("--size {}x{} is too narrow for {} views side by side (16 px each at least)",
+                                 config.width, config.height, config.views));
   gl::RendererOptions ropts;
-  ropts.width = config.width;
+  ropts.width = config.width / config.views;
   ropts.height = config.height;
   ropts.query_mode = config.query_mode;
   ropts.write_ids = false;  // timed frames draw colour and depth only
@@ -481,11 +604,22 @@ BenchResult run_bench(const BenchConfig& config, const ProgressFn& progress) {
   Session session(config.scene, ropts, config.bvh);
   session.set_fault_hooks(config.hooks);
   session.set_sampling(config.sampling);
-  const CameraPath& path = session.path(config.path);
-  if (const int fit = path.frames_that_fit(config.sampling); config.frames > fit)
-    throw InputError(fmt::format(
-        "--frames {} at --fps {} from --start {} s runs past the end of path {} ({:.1f} s): {} frames fit",
-        config.frames, config.sampling.fps, config.sampling.start_s, path.name(), path.duration(), fit));
+  // The path of each view: those named, else the scene's paths in turn.
+  std::vector<const CameraPath*> paths;
+  for (int k = 0; k < config.views; ++k) {
+    if (config.views == 1)
+      paths.push_back(&session.path(config.path));
+    else if (!config.view_paths.empty())
+      paths.push_back(&session.path(config.view_paths.at(std::size_t(k) % config.view_paths.size())));
+    else
+      paths.push_back(&session.bundle().paths.at(std::size_t(k) % session.bundle().paths.size()));
+  }
+  for (const CameraPath* p : paths)
+    if (const int fit = p->frames_that_fit(config.sampling); config.frames > fit)
+      throw InputError(fmt::format(
+          "--frames {} at --fps {} from --start {} s runs past the end of path {} ({:.1f} s): {} frames fit",
+          config.frames, config.sampling.fps, config.sampling.start_s, p->name(), p->duration(), fit));
+  const CameraPath& path = *paths.front();
   bool uses_profile = config.model;
   std::string profile_path;
   for (const auto& n : names) {
@@ -510,6 +644,7 @@ BenchResult run_bench(const BenchConfig& config, const ProgressFn& progress) {
   result.commit = OCCULL_COMMIT;
   result.scene = config.scene;
   result.path = path.name();
+  for (std::size_t k = 1; k < paths.size(); ++k) result.path += " | " + paths[k]->name();
   result.objects = session.bundle().scene.objects().size();
   result.triangles = session.bundle().scene.triangle_count();
   result.bvh_nodes = session.bvh().size();
@@ -529,18 +664,25 @@ BenchResult run_bench(const BenchConfig& config, const ProgressFn& progress) {
   result.query_geometry = gl::describe_query_raster(ropts);
   result.allocator = config.allocator;
 
-  std::vector<FrameTruth> truth;
-  if (config.verify) truth = session.ground_truth(path, config.frames, progress);
+  std::vector<std::vector<FrameTruth>> truths(paths.size());
+  if (config.verify)
+    for (std::size_t k = 0; k < paths.size(); ++k) truths[k] = session.ground_truth(*paths[k], config.frames, progress);
+  const std::vector<FrameTruth>& truth = truths.front();
   const std::vector<FrameTruth>* truth_ptr = config.verify ? &truth : nullptr;
-  for (const FrameTruth& t : truth) {
-    result.truth_probes += t.probes;
-    result.truth_pixels += t.coverage.pixels;
-  }
+  for (const auto& view_truth : truths)
+    for (const FrameTruth& t : view_truth) {
+      result.truth_probes += t.probes;
+      result.truth_pixels += t.coverage.pixels;
+    }
 
   for (int rep = 0; rep < config.repeat; ++rep) {
     for (const auto& name : names) {
       const std::string label = config.repeat > 1 ? fmt::format("{} #{}", name, rep + 1) : name;
       session.reset_renderer();
+      if (config.views > 1) {
+        run_split_screen(session, name, config, paths, truths, rep, label, progress, result.runs);
+        continue;
+      }
       {
         auto warm = session.make(name, config.options);
         for (int k = 0; k < config.warmup; ++k) {
