@@ -513,6 +513,27 @@ int cmd_render(const RenderArgs& a) {
   return 0;
 }
 
+// The options of a run of frames that bench and sweep share; `per` names
+// what the timed and warm-up frames are counted per.
+void add_run_options(CLI::App* cmd, BenchArgs& a, const std::string& per) {
+  cmd->add_option("--scene", a.scene, "scene spec name[:key=value,...] (see occull scenes)")->capture_default_str();
+  cmd->add_option("--path", a.path, "camera path (default: the scene's first), or file:PATH to replay a recorded one");
+  cmd->add_option("--frames", a.frames, "timed frames per " + per)->capture_default_str();
+  cmd->add_option("--warmup", a.warmup, "untimed warm-up frames per " + per)->capture_default_str();
+  cmd->add_option("--fps", a.fps,
+                  "frames at this rate of path time, as a real-time walk renders them (0: spread the frames "
+                  "over the whole path)")
+      ->capture_default_str();
+  cmd->add_option("--start", a.start, "with --fps: path time of the first frame, seconds")->capture_default_str();
+  cmd->add_option("--size", a.size, "render size WIDTHxHEIGHT")->capture_default_str();
+  cmd->add_option("--opt", a.opts, "algorithm option algo.key=value (repeatable)");
+  cmd->add_option("--repeat", a.repeat, "run the whole set R times, interleaved; report medians")
+      ->capture_default_str();
+  cmd->add_option("--verify", a.verify, "check every frame against ground truth (on/off)")->capture_default_str();
+  cmd->add_option("--json", a.json, "write the results as JSON to this file");
+  cmd->add_option("--malloc", a.malloc_policy, kMallocHelp)->capture_default_str();
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -535,21 +556,10 @@ int main(int argc, char** argv) {
 
   BenchArgs bench;
   auto* b = app.add_subcommand("bench", "fly a camera path with each algorithm and report frame times");
-  b->add_option("--scene", bench.scene, "scene spec name[:key=value,...] (see occull scenes)")
-      ->capture_default_str();
-  b->add_option("--path", bench.path, "camera path (default: the scene's first), or file:PATH to replay a recorded one");
+  add_run_options(b, bench, "algorithm");
   b->add_option("--algo", bench.algos,
                 "comma-separated algorithms, each optionally with its own options as "
                 "name:key=value:key=value (default: all; see occull algos)");
-  b->add_option("--frames", bench.frames, "timed frames per algorithm")->capture_default_str();
-  b->add_option("--warmup", bench.warmup, "untimed warm-up frames per algorithm")->capture_default_str();
-  b->add_option("--fps", bench.fps,
-                "frames at this rate of path time, as a real-time walk renders them (0: spread the frames "
-                "over the whole path)")
-      ->capture_default_str();
-  b->add_option("--start", bench.start, "with --fps: path time of the first frame, seconds")->capture_default_str();
-  b->add_option("--size", bench.size, "render size WIDTHxHEIGHT")->capture_default_str();
-  b->add_option("--opt", bench.opts, "algorithm option algo.key=value (repeatable)");
   b->add_option("--query-mode", bench.query_mode, "occlusion query target: samples, any, conservative")
       ->capture_default_str();
   b->add_option("--query-raster", bench.query_raster,
@@ -558,11 +568,6 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   b->add_option("--query-margin", bench.query_margin, "with --query-raster margin: pixels to widen each query box's outline by")
       ->capture_default_str();
-  b->add_option("--repeat", bench.repeat, "run the whole set R times, interleaved; report medians")
-      ->capture_default_str();
-  b->add_option("--verify", bench.verify, "check every frame against ground truth (on/off)")
-      ->capture_default_str();
-  b->add_option("--json", bench.json, "write the results as JSON to this file");
   b->add_option("--csv", bench.csv, "write one CSV row per algorithm, repeat and frame to this file");
   b->add_option("--report", bench.report, "write report.md, SVG charts, JSON and CSV into this folder")
       ->capture_default_str();
@@ -597,26 +602,9 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   sw->add_option("--longest", sweep.longest, "... and no object for more than this many frames in a row")
       ->capture_default_str();
-  sw->add_option("--scene", sweep.bench.scene, "scene spec name[:key=value,...] (see occull scenes)")
-      ->capture_default_str();
-  sw->add_option("--path", sweep.bench.path, "camera path (default: the scene's first), or file:PATH");
-  sw->add_option("--frames", sweep.bench.frames, "timed frames per setting")->capture_default_str();
-  sw->add_option("--warmup", sweep.bench.warmup, "untimed warm-up frames per setting")->capture_default_str();
-  sw->add_option("--fps", sweep.bench.fps, "frames at this rate of path time (0: spread over the whole path)")
-      ->capture_default_str();
-  sw->add_option("--start", sweep.bench.start, "with --fps: path time of the first frame, seconds")
-      ->capture_default_str();
-  sw->add_option("--size", sweep.bench.size, "render size WIDTHxHEIGHT")->capture_default_str();
-  sw->add_option("--opt", sweep.bench.opts, "fixed option algo.key=value for every setting (repeatable)");
-  sw->add_option("--repeat", sweep.bench.repeat, "run the whole set R times, interleaved; report medians")
-      ->capture_default_str();
-  sw->add_option("--verify", sweep.bench.verify, "check every frame against ground truth (on/off); popping needs it")
-      ->capture_default_str();
-  sw->add_option("--json", sweep.bench.json, "write the results as bench JSON to this file");
-  sw->add_option("--malloc", sweep.bench.malloc_policy, kMallocHelp)->capture_default_str();
+  add_run_options(sw, sweep.bench, "setting");
 
   CalibrateArgs calibrate;
-  b->add_option("--malloc", bench.malloc_policy, kMallocHelp)->capture_default_str();
   auto* suite_opt = b->add_option("--suite", bench.suite,
                                   "run a fixed list of scene/path pairs instead of one, with a table each and a summary "
                                   "over all (geometric mean and worst ratio to vfc and oracle per culler): default, quick");
