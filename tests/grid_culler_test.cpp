@@ -83,11 +83,32 @@ TEST(Grid, HidesAnOccludedCellFromTheFrameAfterItsQueryAndQueriesItAgainEachFram
 TEST(Grid, TheThesisLeavesCellsWithoutAnAnswerHidden) {
   Stage s;
   test::RecordingBackend backend;
-  auto culler = s.make({"grid.unknown=hidden"});
+  auto culler = s.make({"grid.unknown=hidden", "grid.latency=1"});
   culler->render_frame(s.view, backend);
   EXPECT_TRUE(backend.rendered.empty());
   culler->render_frame(s.view, backend);
   EXPECT_EQ(times_drawn(backend, 0), 1u);
+}
+
+TEST(Grid, AHiddenCellWhoseQueryFindsItVisibleIsDrawnInTheFrameOfTheQueryWithLatencyZero) {
+  for (int latency : {0, 1}) {
+    Stage s;
+    test::RecordingBackend backend;
+    auto culler = s.make({"grid.latency=" + std::to_string(latency)});
+    backend.visible_samples = behind_wall;
+    for (int frame = 1; frame <= 2; ++frame) culler->render_frame(s.view, backend);
+    // The wall goes: the box behind it is hidden by its last answer, and
+    // this frame's query of its cell finds it visible.
+    backend.visible_samples = [](std::span<const Aabb> boxes) { return std::uint64_t(boxes.size()); };
+    backend.rendered.clear();
+    const FrameStats third = culler->render_frame(s.view, backend);
+    EXPECT_EQ(times_drawn(backend, 1), latency == 0 ? 1u : 0u) << "latency " << latency;
+    EXPECT_EQ(third.revealed > 0, latency == 0) << "latency " << latency;
+    backend.rendered.clear();
+    culler->render_frame(s.view, backend);
+    EXPECT_EQ(times_drawn(backend, 1), 1u) << "next frame, latency " << latency;
+    EXPECT_EQ(times_drawn(backend, 3), 0u) << "outside the frustum, latency " << latency;
+  }
 }
 
 TEST(Grid, VisibleAnswersHoldForVisDurationFrames) {

@@ -274,6 +274,7 @@ struct AlgorithmSummary {
   double capped_share = 0.0;              ///< share of frames that reached the query cap (FrameStats::capped)
   double over_cap_per_frame = 0.0;        ///< queries deferred by the cap (FrameStats::over_cap)
   double result_age_frames = 0.0;         ///< mean age of the answers used (FrameStats::result_age)
+  double revealed_per_frame = 0.0;        ///< hidden cells drawn in the frame of the query that found them visible
   double state_changes_per_frame = 0.0;
   double render_flushes_per_frame = 0.0;
   double draw_calls_per_frame = 0.0;

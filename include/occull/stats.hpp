@@ -33,6 +33,7 @@ struct FrameStats {
   std::uint64_t capped = 0;      ///< 1 when the frame reached the culler's query cap, else 0
   std::uint64_t over_cap = 0;    ///< queries due but deferred by the cap
   double result_age = 0.0;       ///< mean frames since the query behind each answer used was issued
+  std::uint64_t revealed = 0;    ///< hidden cells whose query found them visible and were drawn in its frame
 
   // Backend counters (differences over the frame).
   std::uint64_t queries = 0;

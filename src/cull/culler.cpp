@@ -91,6 +91,7 @@ const std::vector<Entry>& registry() {
          {"prepass", "75", "occluders of class sometimes drawn in the pre-pass per frame (class always: all)"},
          {"unknown", "visible", "a cell the frustum did not meet last frame: visible (draw it while its query runs) or hidden (the thesis: it pops in a frame late)"},
          {"tight", "on", "query the box of what a cell holds instead of the whole cell"},
+         {"latency", "0", "frames before a hidden cell's answer is used: 0 waits for it after the colour pass and draws the cells found visible in the same frame; 1 uses it next frame (the thesis: they pop in a frame late)"},
          {"conditional", "wait", "pre-pass of a cell queried this frame under conditional rendering on its query: wait (the device waits for the result), no_wait (draws while it is unknown) or off"},
          {"threshold", "0", "a cell is visible when more samples (pixels) pass"},
          {"seed", "1", "random seed of the answers' extra duration when capped"},

@@ -363,6 +363,7 @@ std::vector<AlgorithmSummary> summarize_runs(std::span<const AlgorithmRun> runs)
         sums["capped"] += double(f.capped);
         sums["over_cap"] += double(f.over_cap);
         sums["result_age"] += f.result_age;
+        sums["revealed"] += double(f.revealed);
         sums["state_changes"] += double(f.state_changes);
         sums["render_flushes"] += double(f.render_flushes);
         sums["draw_calls"] += double(f.draw_calls);
@@ -424,6 +425,7 @@ std::vector<AlgorithmSummary> summarize_runs(std::span<const AlgorithmRun> runs)
     a.capped_share = med("capped");
     a.over_cap_per_frame = med("over_cap");
     a.result_age_frames = med("result_age");
+    a.revealed_per_frame = med("revealed");
     a.state_changes_per_frame = med("state_changes");
     a.render_flushes_per_frame = med("render_flushes");
     a.draw_calls_per_frame = med("draw_calls");
@@ -474,6 +476,7 @@ void add_view(FrameStats& sum, const FrameStats& v) {
   sum.query_batches += v.query_batches;
   sum.capped = std::max(sum.capped, v.capped);
   sum.over_cap += v.over_cap;
+  sum.revealed += v.revealed;
   sum.result_age += v.result_age;  // divided by the views at the end
   sum.queries += v.queries;
   sum.query_boxes += v.query_boxes;
