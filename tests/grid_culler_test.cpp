@@ -259,57 +259,72 @@ TEST(QueryBudget, SplitsEvenlyFirstThenGrantsDemandsThatFitAndSharesTheSlack) {
   QueryBudget b(100, 2);
   EXPECT_EQ(b.allowance(0), 50);
   EXPECT_EQ(b.allowance(1), 50);
-  b.report(0, 30, 10, 0);
-  b.report(1, 15, 0, 5);
+  b.report(0, 20, 10, 2, 0);
+  b.report(1, 5, 10, 0, 5);
   b.split();
   EXPECT_EQ(b.allowance(0), 30 + 25);
   EXPECT_EQ(b.allowance(1), 20 + 25);
 }
 
-TEST(QueryBudget, OverTheCapAViewWhoseQueriesCullGetsMoreThanOneWhoseQueriesDoNot) {
+TEST(QueryBudget, OverTheCapAViewWhoseHiddenCellsComeIntoSightGetsMoreThanOneWhoseStayHidden) {
   QueryBudget b(100, 2, 0.25);
   for (int frame = 0; frame < 12; ++frame) {
-    b.report(0, 150, 120, 50);  // 80 % of its queries find a hidden cell
-    b.report(1, 150, 0, 50);    // none of its queries culls anything
+    b.report(0, 20, 40, 20, 60);  // half of its re-queries find a hidden cell visible again
+    b.report(1, 20, 40, 0, 60);   // none do: its stale answers were right
     b.split();
   }
-  EXPECT_GT(b.benefit(0), 0.7);
-  EXPECT_LT(b.benefit(1), 0.1);
+  EXPECT_GT(b.reveal_rate(0), 0.45);
+  EXPECT_LT(b.reveal_rate(1), 0.05);
   EXPECT_LE(b.allowance(0) + b.allowance(1), 100);
-  EXPECT_GT(b.allowance(0), 3 * b.allowance(1));
-  EXPECT_GE(b.allowance(1), 12) << "the floor: a quarter of an even share";
-  // Equal demand and benefit: an even split.
-  QueryBudget even(100, 2);
-  even.report(0, 150, 75, 50);
-  even.report(1, 150, 75, 50);
+  EXPECT_GE(b.allowance(1), 20 + 7) << "its drawn cells' queries and the floor: a quarter of an even share of 60";
+  EXPECT_GT(b.allowance(0) - 20, 3 * (b.allowance(1) - 20));
+  // The drawn cells' queries come first: a view that draws more gets more.
+  QueryBudget drawn(100, 2);
+  drawn.report(0, 50, 40, 10, 40);
+  drawn.report(1, 10, 40, 10, 40);
+  drawn.split();
+  EXPECT_EQ(drawn.allowance(0) - 50, drawn.allowance(1) - 10);
+  EXPECT_EQ(drawn.allowance(0) + drawn.allowance(1), 100);
+  // The baseline ignores every report.
+  QueryBudget even(100, 2, 0.25, QueryBudget::Policy::even);
+  even.report(0, 20, 40, 20, 60);
+  even.report(1, 20, 40, 0, 60);
   even.split();
-  EXPECT_EQ(even.allowance(0), even.allowance(1));
+  EXPECT_EQ(even.allowance(0), 50);
+  EXPECT_EQ(even.allowance(1), 50);
   EXPECT_THROW(QueryBudget(1, 2), InputError);
 }
 
-TEST(GridViews, ViewsShareOneGridAndTheViewWhoseQueriesCullGetsTheLargerShare) {
+TEST(GridViews, ViewsShareOneGridAndTheViewWhoseHiddenCellsComeIntoSightGetsTheLargerShare) {
   Stage s;
-  // View 1 stands left of the wall looking down -X: it sees object 3 in the open.
-  const View left = make_view({{-10, 1, -10.5f}, 1.5707963f, 0}, {60.0f, 0.5f, 100.0f}, 64, 64);
   Options o;
   o.set("grid.cell=2");
-  o.set("grid.cap=8");
-  test::RecordingBackend front, side;  // outlive the views, which read their last queries on destruction
-  front.visible_samples = behind_wall;
+  o.set("grid.cap=6");
+  o.set("grid.vis_duration=1");
+  o.set("grid.split=reveal");
+  // Both views look past the wall. In view 0 the wall comes and goes (every
+  // other frame everything is visible), so re-queries of its hidden cells
+  // find them visible again; in view 1 the wall stands.
+  int frame = 0;
+  test::RecordingBackend flicker, steady;  // outlive the views, which read their last queries on destruction
+  flicker.visible_samples = [&frame](std::span<const Aabb> boxes) {
+    return frame % 2 == 0 ? std::uint64_t(boxes.size()) : behind_wall(boxes);
+  };
+  steady.visible_samples = behind_wall;
   GridViews views({s.scene, s.bvh}, 2, o);
   EXPECT_EQ(views.grid().occupied(), UniformGrid::of_scene(s.scene, 2.0f).occupied());
-  for (int frame = 1; frame <= 8; ++frame) {
+  for (frame = 1; frame <= 20; ++frame) {
     views.begin_frame();
-    front.rendered.clear();
-    side.rendered.clear();
-    views.view(0).render_frame(s.view, front);
-    views.view(1).render_frame(left, side);
-    EXPECT_EQ(times_drawn(front, 0), 1u) << "frame " << frame;
-    EXPECT_EQ(times_drawn(front, 3), 0u) << "frame " << frame;
-    EXPECT_EQ(times_drawn(side, 3), 1u) << "frame " << frame;
-    EXPECT_EQ(times_drawn(side, 0), 0u) << "frame " << frame;
+    steady.rendered.clear();
+    views.view(0).render_frame(s.view, flicker);
+    views.view(1).render_frame(s.view, steady);
+    EXPECT_EQ(times_drawn(steady, 0), 1u) << "frame " << frame;
+    EXPECT_EQ(times_drawn(steady, 3), 0u) << "frame " << frame;
   }
-  EXPECT_GT(views.budget().benefit(0), views.budget().benefit(1));
+  // Of view 0's re-queries, those that drew the box behind the wall count
+  // (its other cells hold nothing undrawn); view 1's reveal nothing.
+  EXPECT_GT(views.budget().reveal_rate(0), 2 * views.budget().reveal_rate(1));
+  EXPECT_LT(views.budget().reveal_rate(1), 0.02);
   EXPECT_GT(views.budget().allowance(0), views.budget().allowance(1));
-  EXPECT_LE(views.budget().allowance(0) + views.budget().allowance(1), 8);
+  EXPECT_LE(views.budget().allowance(0) + views.budget().allowance(1), 6);
 }

@@ -95,7 +95,8 @@ const std::vector<Entry>& registry() {
          {"conditional", "wait", "pre-pass of a cell queried this frame under conditional rendering on its query: wait (the device waits for the result), no_wait (draws while it is unknown) or off"},
          {"threshold", "0", "a cell is visible when more samples (pixels) pass"},
          {"seed", "1", "random seed of the answers' extra duration when capped"},
-         {"split_floor", "0.25", "split screen (bench --views): share of an even split of the cap each view is sure of; the rest goes by demand x share of queries that find cells hidden (1: an even split)"}}},
+         {"split", "even", "split screen (bench --views): how the views share the cap; even: cap / views each; reveal: what the queries of drawn cells leave goes by demand x share of the view's deferred hidden cells whose re-query found them visible (measured: less popping than even only with invis_growth=0)"},
+         {"split_floor", "0.25", "with split=reveal: share of an even split of what the queries of drawn cells leave each view is sure of"}}},
        &detail::make_grid},
       {{"auto",
         "adaptive: runs the cheapest of chcpp, vfc and nohc for this view, learnt from the measured frame times, "

@@ -139,7 +139,7 @@ class GridCuller final : public Culler {
           if (queries < cap || draw) {
             query = backend.issue_query(std::span<const Aabb>(&box, 1));
             queried = true;
-            pending_.push_back({query, c, draw});
+            pending_.push_back({query, c, draw, cell.until < frame_});
             ++queries;
             ++stats.query_batches;
           } else {
@@ -190,8 +190,10 @@ class GridCuller final : public Culler {
     QueryId query;
     std::uint32_t cell;
     bool drawn;             // the cell's objects were drawn in the frame of the query
+    bool overdue;           // its answer had expired before that frame: the cap deferred it
     bool settled = false;   // result read in that frame already (reveal), kept in `visible`
     bool visible = false;
+    bool useful = false;    // settled, visible, and it drew an object no other cell had drawn
   };
 
   // `latency=0`: waits for the queries of this frame's undrawn cells and
@@ -210,7 +212,9 @@ class GridCuller final : public Culler {
       for (ObjectId id : grid_->objects(p.cell)) {
         if (drawn_[id] == frame_) continue;
         drawn_[id] = frame_;
-        if (view.frustum.classify(scene_.object(id).bounds) != Containment::outside) colour_.push_back(id);
+        if (view.frustum.classify(scene_.object(id).bounds) == Containment::outside) continue;
+        colour_.push_back(id);
+        p.useful = true;
       }
     }
     if (!colour_.empty()) backend.render(colour_);
@@ -221,17 +225,27 @@ class GridCuller final : public Culler {
   void gather(Backend& backend) {
     const int grow = capped_frames_;
     std::uniform_int_distribution<int> offset(0, 2 * grow);
-    std::uint64_t hidden = 0;
+    // Re-queries of hidden cells, all and those the cap had deferred.
+    std::uint64_t forced = 0, rechecked[2] = {0, 0}, revealed[2] = {0, 0};
     for (const Pending& p : pending_) {
       Cell& cell = cells_[p.cell];
       cell.visible = p.settled ? p.visible : backend.result(p.query) > config_.threshold;
-      hidden += cell.visible ? 0 : 1;
+      forced += p.drawn ? 1 : 0;
+      if (!p.drawn) {
+        for (int k = 0; k < (p.overdue ? 2 : 1); ++k) {
+          ++rechecked[k];
+          revealed[k] += (p.settled ? p.useful : cell.visible) ? 1 : 0;
+        }
+      }
       cell.asked = frame_;
       const int base = cell.visible ? config_.vis_duration + config_.vis_growth * grow
                                     : config_.invis_duration + config_.invis_growth * grow;
       cell.until = frame_ + std::uint64_t(base) + std::uint64_t(grow > 0 ? offset(rng_) : 0);
     }
-    if (budget_) budget_->report(view_, pending_.size(), hidden, deferred_);
+    // The budget wants the odds that a deferred re-query would find its
+    // cell visible: those of the deferred ones that ran, if any did.
+    const int k = rechecked[1] > 0 ? 1 : 0;
+    if (budget_) budget_->report(view_, forced, rechecked[k], revealed[k], deferred_);
     pending_.clear();
   }
 
@@ -301,51 +315,59 @@ std::unique_ptr<Culler> make_grid(const SceneIndex& index, const Options& o) {
 
 namespace occull {
 
-QueryBudget::QueryBudget(int total, int views, double floor)
-    : total_(total), floor_(floor), allowance_(std::size_t(views)), benefit_(std::size_t(views), 1.0),
-      demand_(std::size_t(views), 0) {
+QueryBudget::QueryBudget(int total, int views, double floor, Policy policy)
+    : total_(total), floor_(floor), policy_(policy), allowance_(std::size_t(views)), rate_(std::size_t(views), 1.0),
+      forced_(std::size_t(views), 0), optional_(std::size_t(views), 0) {
   if (views < 1 || total < views || !(floor >= 0.0 && floor <= 1.0))
     throw InputError(fmt::format("query budget: {} queries for {} views (floor {}) cannot be split", total, views,
                                  floor));
   for (int& a : allowance_) a = total / views;
 }
 
-void QueryBudget::report(int view, std::uint64_t issued, std::uint64_t hidden, std::uint64_t deferred) {
+void QueryBudget::report(int view, std::uint64_t forced, std::uint64_t rechecked, std::uint64_t revealed,
+                         std::uint64_t deferred) {
   const std::size_t k = std::size_t(view);
-  demand_.at(k) = issued + deferred;
-  if (issued == 0) return;
-  const double share = double(std::min(hidden, issued)) / double(issued);
-  benefit_[k] = std::max(0.01, 0.75 * benefit_[k] + 0.25 * share);
+  forced_.at(k) = forced;
+  optional_.at(k) = rechecked + deferred;
+  if (rechecked == 0) return;
+  const double share = double(std::min(revealed, rechecked)) / double(rechecked);
+  rate_[k] = std::max(0.01, 0.75 * rate_[k] + 0.25 * share);
 }
 
 void QueryBudget::split() {
+  if (policy_ == Policy::even) return;  // the constructor's even shares
   const std::size_t n = allowance_.size();
-  std::uint64_t wanted = 0;
-  for (std::uint64_t d : demand_) wanted += d;
+  std::uint64_t wanted = 0, forced = 0;
+  for (std::size_t k = 0; k < n; ++k) {
+    wanted += forced_[k] + optional_[k];
+    forced += forced_[k];
+  }
   if (wanted <= std::uint64_t(total_)) {
     // Everyone gets what it asked for; the slack is shared evenly.
     const std::uint64_t slack = (std::uint64_t(total_) - wanted) / n;
-    for (std::size_t k = 0; k < n; ++k) allowance_[k] = int(demand_[k] + slack);
+    for (std::size_t k = 0; k < n; ++k) allowance_[k] = int(forced_[k] + optional_[k] + slack);
   } else {
-    // A floor each, then the rest by demand x benefit, capped at the remaining demand.
-    const auto floor_each = std::uint64_t(floor_ * double(total_) / double(n));
+    // What the forced queries leave: a floor each, then the rest by
+    // remaining optional demand x reveal rate.
+    const std::uint64_t free = forced < std::uint64_t(total_) ? std::uint64_t(total_) - forced : 0;
+    const auto floor_each = std::uint64_t(floor_ * double(free) / double(n));
     std::vector<std::uint64_t> grant(n), rest(n);
-    std::uint64_t left = std::uint64_t(total_);
+    std::uint64_t left = free;
     for (std::size_t k = 0; k < n; ++k) {
-      grant[k] = std::min(demand_[k], floor_each);
-      rest[k] = demand_[k] - grant[k];
+      grant[k] = std::min(optional_[k], floor_each);
+      rest[k] = optional_[k] - grant[k];
       left -= grant[k];
     }
     // Proportional shares; a view that needs less than its share passes the remainder on.
     for (int round = 0; round < int(n) && left > 0; ++round) {
       double weight = 0.0;
       for (std::size_t k = 0; k < n; ++k)
-        if (rest[k] > 0) weight += double(rest[k]) * benefit_[k];
+        if (rest[k] > 0) weight += double(rest[k]) * rate_[k];
       if (weight <= 0.0) break;
       std::uint64_t given = 0;
       for (std::size_t k = 0; k < n; ++k) {
         if (rest[k] == 0) continue;
-        const auto share = std::uint64_t(double(left) * double(rest[k]) * benefit_[k] / weight);
+        const auto share = std::uint64_t(double(left) * double(rest[k]) * rate_[k] / weight);
         const std::uint64_t g = std::min(rest[k], share);
         grant[k] += g;
         rest[k] -= g;
@@ -354,7 +376,7 @@ void QueryBudget::split() {
       left -= given;
       if (given == 0) break;
     }
-    for (std::size_t k = 0; k < n; ++k) allowance_[k] = int(grant[k]);
+    for (std::size_t k = 0; k < n; ++k) allowance_[k] = int(forced_[k] + grant[k]);
   }
   for (int& a : allowance_) a = std::max(a, 1);
 }
@@ -365,7 +387,9 @@ GridViews::GridViews(const SceneIndex& index, int views, const Options& options)
   const detail::GridConfig c = detail::grid_config(options);
   grid_ = std::make_shared<UniformGrid>(UniformGrid::of_scene(index.scene, c.cell));
   const double floor = options.get_double("grid.split_floor", 0.25, 0.0, 1.0);
-  budget_ = std::make_shared<QueryBudget>(std::max(c.cap, views), views, floor);
+  const bool even = options.get_choice("grid.split", "even", {"even", "reveal"}) == "even";
+  budget_ = std::make_shared<QueryBudget>(std::max(c.cap, views), views, floor,
+                                          even ? QueryBudget::Policy::even : QueryBudget::Policy::reveal);
   for (int k = 0; k < views; ++k) {
     detail::GridConfig view_config = c;
     view_config.seed = c.seed + std::uint32_t(k);
