@@ -53,7 +53,7 @@ enum Column { kMean = 1, kMedian, kP95, kMax, kVsVfc, kVsOracle, kQueries, kStat
 
 TEST(Cli, HelpOnEveryCommandNamesItsOptions) {
   const std::vector<std::pair<std::string, std::vector<std::string>>> commands = {
-      {"", {"bench", "sweep", "calibrate", "render", "scenes", "algos", "info", "path", "Exit codes"}},
+      {"", {"bench", "sweep", "calibrate", "render", "scenes", "algos", "info", "path", "traverse", "Exit codes"}},
       {"info", {"--help"}},
       {"scenes", {"--list-maps"}},
       {"algos", {"--help"}},
@@ -63,7 +63,8 @@ TEST(Cli, HelpOnEveryCommandNamesItsOptions) {
                  "--suite", "--malloc", "--views"}},
       {"calibrate", {"--size", "--repeats", "--out", "--check"}},
       {"sweep", {"--algo", "--vary", "--baseline", "--popping", "--longest", "--scene", "--frames", "--json"}},
-      {"render", {"--scene", "--frame", "--fps", "--out"}}};
+      {"render", {"--scene", "--frame", "--fps", "--out"}},
+      {"traverse", {"--dims", "--views", "--mode", "--fov", "--seed"}}};
   for (const auto& [cmd, options] : commands) {
     const CliRun r = run(cmd + " --help");
     EXPECT_EQ(r.code, 0) << cmd << ": " << r.output;
@@ -491,6 +492,18 @@ TEST(Cli, SweepOfAnUnknownOptionListsTheValidOnes) {
   EXPECT_NE(r.output.find("valid options: cell, traversal, cap"), std::string::npos) << r.output;
   const CliRun two = run("sweep --algo grid,vfc --vary cap=1");
   EXPECT_EQ(two.code, 2) << two.output;
+}
+
+TEST(Cli, TraverseTimesTheGridTraversalAndRejectsBadDimensions) {
+  const CliRun r = run("traverse --dims 30x4x20 --views 5");
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("grid 30x4x20 (2400 cells), 5 views"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("traversal per view: median"), std::string::npos) << r.output;
+  for (const char* bad : {"--dims 30x4", "--dims 0x4x20", "--mode cone", "--views 0"}) {
+    const CliRun e = run(std::string("traverse ") + bad);
+    EXPECT_EQ(e.code, 2) << bad << ": " << e.output;
+  }
+  EXPECT_NE(run("traverse --mode cone").output.find("valid modes are frustum, box"), std::string::npos);
 }
 
 TEST(Cli, SplitScreenBenchNamesBothPathsAndAPathListNeedsViews) {

@@ -8,6 +8,7 @@
 // table and report are written first).
 #include "occull/culler.hpp"
 #include "occull/error.hpp"
+#include "occull/grid.hpp"
 #include "occull/gl/calibrate.hpp"
 #include "occull/gl/context.hpp"
 #include "occull/gl/renderer.hpp"
@@ -30,6 +31,7 @@
 #include <fstream>
 #include <iostream>
 #include <memory>
+#include <random>
 #include <unistd.h>
 
 namespace {
@@ -534,6 +536,65 @@ void add_run_options(CLI::App* cmd, BenchArgs& a, const std::string& per) {
   cmd->add_option("--malloc", a.malloc_policy, kMallocHelp)->capture_default_str();
 }
 
+struct TraverseArgs {
+  std::string dims = "1000x10x1000";
+  int views = 200;
+  std::string mode = "frustum";
+  float fov = 60.0f;
+  unsigned seed = 1;
+};
+
+// Times GridTraversal on one core: random views inside a grid of unit
+// cells, each looking roughly level (pitch within 20 degrees) with a far
+// plane reaching across the whole grid, the worst case for the traversal.
+int cmd_traverse(const TraverseArgs& a) {
+  int x = 0, y = 0, z = 0;
+  char c1 = 0, c2 = 0, extra = 0;
+  if (std::sscanf(a.dims.c_str(), "%d%c%d%c%d%c", &x, &c1, &y, &c2, &z, &extra) != 5 || c1 != 'x' || c2 != 'x')
+    throw occull::InputError(fmt::format("--dims '{}' is not XxYxZ (e.g. 1000x10x1000)", a.dims));
+  if (x < 1 || y < 1 || z < 1 || x > (1 << 20) || y > (1 << 20) || z > (1 << 20))
+    throw occull::InputError(fmt::format("--dims {}: each count must be in [1, 2^20]", a.dims));
+  if (a.views < 1) throw occull::InputError("--views must be at least 1");
+  if (!(a.fov > 1.0f && a.fov < 179.0f)) throw occull::InputError("--fov must be in (1, 179) degrees");
+  occull::GridTraversal::Mode mode;
+  if (a.mode == "frustum") mode = occull::GridTraversal::Mode::frustum;
+  else if (a.mode == "box") mode = occull::GridTraversal::Mode::box;
+  else throw occull::InputError(fmt::format("--mode '{}': valid modes are frustum, box", a.mode));
+
+  occull::GridGeometry grid;
+  grid.dims = {x, y, z};
+  const glm::vec3 size(grid.dims);
+  std::mt19937 rng(a.seed);
+  std::uniform_real_distribution<float> u(0.0f, 1.0f);
+  occull::Lens lens;
+  lens.fov_y_degrees = a.fov;
+  lens.near = 0.1f;
+  lens.far = glm::length(size) + 1.0f;
+  occull::GridTraversal traversal;
+  std::vector<double> us;
+  double cells = 0.0, runs = 0.0;
+  for (int i = 0; i < a.views; ++i) {
+    occull::CameraPose pose;
+    pose.position = size * glm::vec3(u(rng), std::min(0.5f, 1.5f / size.y) + 0.5f * u(rng), u(rng));
+    pose.yaw = 6.2831853f * u(rng);
+    pose.pitch = 0.7f * (u(rng) - 0.5f);
+    const occull::View view = occull::make_view(pose, lens, 1280, 720);
+    const auto t0 = std::chrono::steady_clock::now();
+    const auto list = traversal.traverse(grid, view, mode);
+    const auto t1 = std::chrono::steady_clock::now();
+    us.push_back(std::chrono::duration<double, std::micro>(t1 - t0).count());
+    runs += double(list.size());
+    for (const occull::CellRun& r : list) cells += r.count;
+  }
+  std::sort(us.begin(), us.end());
+  const auto at = [&](double q) { return us[std::min(us.size() - 1, std::size_t(q * double(us.size())))]; };
+  fmt::print("grid {} ({} cells), {} views, fov {} deg, far {:.0f} cells, mode {}\n", a.dims,
+             grid.cell_count(), a.views, a.fov, lens.far, a.mode);
+  fmt::print("traversal per view: median {:.1f} us, p95 {:.1f} us, max {:.1f} us; {:.0f} cells in {:.0f} runs on average\n",
+             at(0.5), at(0.95), us.back(), cells / a.views, runs / a.views);
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -633,6 +694,17 @@ int main(int argc, char** argv) {
   r->add_option("--out", render.out, "output PNG file")->capture_default_str();
   r->add_option("--opt", render.opts, "algorithm option algo.key=value (repeatable)");
 
+  TraverseArgs traverse;
+  auto* tv = app.add_subcommand("traverse",
+                                "time the grid's occlusion-order traversal on one core over random views "
+                                "(far plane across the whole grid)");
+  tv->add_option("--dims", traverse.dims, "grid cells XxYxZ")->capture_default_str();
+  tv->add_option("--views", traverse.views, "random views timed")->capture_default_str();
+  tv->add_option("--mode", traverse.mode, "frustum (the thesis' rasterization) or box (the frustum's bounding box)")
+      ->capture_default_str();
+  tv->add_option("--fov", traverse.fov, "vertical field of view, degrees (16:9 viewport)")->capture_default_str();
+  tv->add_option("--seed", traverse.seed, "random seed of the views")->capture_default_str();
+
   // An unknown command: name it and list the valid ones (CLI11 would only
   // say that a subcommand is required).
   if (argc > 1 && argv[1][0] != '-') {
@@ -664,6 +736,7 @@ int main(int argc, char** argv) {
     if (cmd == "sweep") return cmd_sweep(sweep);
     if (cmd == "render") return cmd_render(render);
     if (cmd == "calibrate") return cmd_calibrate(calibrate);
+    if (cmd == "traverse") return cmd_traverse(traverse);
   } catch (const occull::InputError& e) {
     std::cerr << "occull: " << e.what() << "\n";
     return kExitInput;

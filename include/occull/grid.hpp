@@ -157,7 +157,18 @@ class GridTraversal {
   std::span<const CellRun> traverse(const GridGeometry& grid, const View& view, Mode mode = Mode::frustum);
 
  private:
+  // Per cell layer along the slicing axis, made in traversal number
+  // `stamp`: its rows row_first.. (rows of them), each row's range of cells
+  // along the run axis at row_cells_[offset + row - row_first].
+  struct Slab {
+    std::uint64_t stamp = 0;
+    int row_first = 0, rows = 0;
+    std::uint32_t offset = 0;
+  };
   std::vector<CellRun> runs_;
+  std::vector<Slab> slabs_;
+  std::vector<glm::ivec2> row_cells_;
+  std::uint64_t stamp_ = 0;
 };
 
 }  // namespace occull

@@ -317,8 +317,13 @@ std::span<const CellRun> GridTraversal::traverse(const GridGeometry& g, const Vi
     return off(p) < off(q);
   });
 
-  const auto cell_lo = [&](int a, double v) { return int(std::floor((v - origin[a]) / cell[a] - kMargin)); };
-  const auto cell_hi = [&](int a, double v) { return int(std::floor((v - origin[a]) / cell[a] + kMargin)); };
+  // The cell along axis a holding v (less, or plus, the margin), clamped to
+  // [-1, dims] so that far-away coordinates do not overflow.
+  const auto cell_at = [&](int a, double v, double margin) {
+    return int(std::clamp(std::floor((v - origin[a]) / cell[a] + margin), -1.0, double(g.dims[a])));
+  };
+  const auto cell_lo = [&](int a, double v) { return cell_at(a, v, -kMargin); };
+  const auto cell_hi = [&](int a, double v) { return cell_at(a, v, kMargin); };
   // The cells of `r` within [lo, hi] (world coordinates along axis a), in
   // the piece's order; false when none.
   const auto clip_range = [&](int a, const AxisRange& r, double lo, double hi, AxisRange& out) {
@@ -328,18 +333,95 @@ std::span<const CellRun> GridTraversal::traverse(const GridGeometry& g, const Vi
     out = r.step > 0 ? AxisRange{l, h, 1, r.off_eye} : AxisRange{h, l, -1, r.off_eye};
     return true;
   };
-  const auto emit = [&](const CellCoord& at, int a, const AxisRange& r) {
+  const int d = axis[0], d2 = axis[1], d3 = axis[2];
+  // Unit steps along the three axes, so a run's cell is computed, not
+  // written through a run-time index.
+  CellCoord unit_d(0), unit_d2(0), unit_d3(0);
+  unit_d[d] = unit_d2[d2] = unit_d3[d3] = 1;
+  // Cells t0..t1 along d2 (rows), each with its cells v0..v1 along d3.
+  const auto emit_row = [&](int s, int t, int v_first, int v_last, int v_step) {
     CellRun run;
-    run.start = at;
-    run.start[a] = r.first;
-    run.step[a] = r.step;
-    run.count = r.hi() - r.lo() + 1;
+    run.start = unit_d * s + unit_d2 * t + unit_d3 * v_first;
+    run.step = unit_d3 * v_step;
+    run.count = std::abs(v_last - v_first) + 1;
     runs_.push_back(run);
   };
 
-  std::vector<glm::dvec3> verts;
+  // The frustum within cell layer s along d (widened by eps), seen along d,
+  // is a convex polygon in (d2, d3): its vertices are where frustum edges
+  // cross the layer's two faces, and frustum corners inside the layer. Per
+  // row t along d2 (a strip widened by eps), the polygon's extent along d3
+  // gives the row's cells. Both are made once per layer and shared by every
+  // piece crossing it: a piece clips rows and cells to its own ranges, which
+  // is the same as clipping the polygon to them first (its ranges are
+  // products of intervals).
+  ++stamp_;
+  row_cells_.clear();
+  if (slabs_.size() < std::size_t(g.dims[d])) slabs_.resize(std::size_t(g.dims[d]));
   std::vector<glm::dvec2> flat, hull;
-  const int d = axis[0], d2 = axis[1], d3 = axis[2];
+  const auto slab_of = [&](int s) -> const Slab& {
+    Slab& slab = slabs_[std::size_t(s)];
+    if (slab.stamp == stamp_) return slab;
+    slab.stamp = stamp_;
+    slab.row_first = 0;
+    slab.rows = 0;
+    const double lo = origin[d] + cell[d] * double(s) - eps, hi = lo + cell[d] + 2.0 * eps;
+    flat.clear();
+    for (const glm::dvec3& c : f.corner)
+      if (c[d] >= lo && c[d] <= hi) flat.push_back({c[d2], c[d3]});
+    for (const auto& e : kEdges) {
+      const glm::dvec3& p = f.corner[std::size_t(e[0])];
+      const glm::dvec3& q = f.corner[std::size_t(e[1])];
+      const double span = q[d] - p[d];
+      if (span == 0.0) continue;
+      for (const double v : {lo, hi}) {
+        const double t = (v - p[d]) / span;
+        if (t <= 0.0 || t >= 1.0) continue;
+        flat.push_back({p[d2] + (q[d2] - p[d2]) * t, p[d3] + (q[d3] - p[d3]) * t});
+      }
+    }
+    if (flat.empty()) return slab;
+    hull.resize(2 * flat.size());
+    hull.resize(convex_hull(flat, hull.data()));
+    double u_lo = hull[0].x, u_hi = hull[0].x;
+    for (const glm::dvec2& p : hull) {
+      u_lo = std::min(u_lo, p.x);
+      u_hi = std::max(u_hi, p.x);
+    }
+    const int t0 = std::max(0, cell_lo(d2, u_lo)), t1 = std::min(g.dims[d2] - 1, cell_hi(d2, u_hi));
+    if (t0 > t1) return slab;
+    slab.row_first = t0;
+    slab.rows = t1 - t0 + 1;
+    slab.offset = std::uint32_t(row_cells_.size());
+    const std::size_t n = hull.size();
+    for (int t = t0; t <= t1; ++t) {
+      // The polygon within strip t: the parts of its edges with lo <= u <= hi.
+      const double strip_lo = origin[d2] + cell[d2] * double(t) - eps;
+      const double strip_hi = strip_lo + cell[d2] + 2.0 * eps;
+      double v_lo = std::numeric_limits<double>::infinity(), v_hi = -v_lo;
+      for (std::size_t i = 0; i < n; ++i) {
+        const glm::dvec2 p = hull[i], q = hull[i + 1 == n ? 0 : i + 1];
+        double t_in = 0.0, t_out = 1.0;
+        const double du = q.x - p.x;
+        if (du == 0.0) {
+          if (p.x < strip_lo || p.x > strip_hi) continue;
+        } else {
+          const double a = (strip_lo - p.x) / du, b = (strip_hi - p.x) / du;
+          t_in = std::max(t_in, std::min(a, b));
+          t_out = std::min(t_out, std::max(a, b));
+          if (t_in > t_out) continue;
+        }
+        const double v0 = p.y + (q.y - p.y) * t_in, v1 = p.y + (q.y - p.y) * t_out;
+        v_lo = std::min({v_lo, v0, v1});
+        v_hi = std::max({v_hi, v0, v1});
+      }
+      // An empty row keeps an empty range (lo > hi).
+      row_cells_.push_back(v_lo <= v_hi ? glm::ivec2(cell_lo(d3, v_lo), cell_hi(d3, v_hi)) : glm::ivec2(1, 0));
+    }
+    return slab;
+  };
+
+  std::vector<glm::dvec3> verts;
   for (const auto& piece : pieces) {
     DBox box;
     for (int a = 0; a < 3; ++a) {
@@ -360,69 +442,34 @@ std::span<const CellRun> GridTraversal::traverse(const GridGeometry& g, const Vi
       any = any && clip_range(a, piece[std::size_t(a)], extent.lo[a], extent.hi[a], r[std::size_t(a)]);
     if (!any) continue;
 
-    for (int s = r[std::size_t(d)].first;; s += r[std::size_t(d)].step) {
-      CellCoord at(0);
-      at[d] = s;
+    const AxisRange& slices = r[std::size_t(d)];
+    const AxisRange& rows = r[std::size_t(d2)];
+    const AxisRange& cols = r[std::size_t(d3)];
+    for (int s = slices.first;; s += slices.step) {
       if (mode == Mode::box) {
-        for (int t = r[std::size_t(d2)].first;; t += r[std::size_t(d2)].step) {
-          at[d2] = t;
-          emit(at, d3, r[std::size_t(d3)]);
-          if (t == r[std::size_t(d2)].last) break;
+        for (int t = rows.first;; t += rows.step) {
+          emit_row(s, t, cols.first, cols.last, cols.step);
+          if (t == rows.last) break;
         }
       } else {
-        // The slice: the piece within cell layer s along d, seen along d.
-        DBox slab = box;
-        slab.lo[d] = origin[d] + cell[d] * double(s);
-        slab.hi[d] = slab.lo[d] + cell[d];
-        verts.clear();
-        intersection_vertices(f, slab, eps, verts);
-        if (!verts.empty()) {
-          flat.clear();
-          for (const glm::dvec3& v : verts) flat.push_back({v[d2], v[d3]});
-          hull.resize(2 * flat.size());
-          hull.resize(convex_hull(flat, hull.data()));
-          double u_lo = hull[0].x, u_hi = hull[0].x;
-          for (const glm::dvec2& p : hull) {
-            u_lo = std::min(u_lo, p.x);
-            u_hi = std::max(u_hi, p.x);
-          }
-          AxisRange rows;
-          if (clip_range(d2, r[std::size_t(d2)], u_lo, u_hi, rows)) {
-            for (int t = rows.first;; t += rows.step) {
-              // The row: the slice polygon within cell strip t along d2;
-              // its extent along d3 gives the run of cells.
-              const double lo = origin[d2] + cell[d2] * double(t) - eps;
-              const double hi = lo + cell[d2] + 2.0 * eps;
-              double v_lo = std::numeric_limits<double>::infinity(), v_hi = -v_lo;
-              const std::size_t n = hull.size();
-              for (std::size_t i = 0; i < n; ++i) {
-                const glm::dvec2 p = hull[i], q = hull[(i + 1) % n];
-                // The part of segment p-q with lo <= u <= hi.
-                double t0 = 0.0, t1 = 1.0;
-                const double du = q.x - p.x;
-                if (du == 0.0) {
-                  if (p.x < lo || p.x > hi) continue;
-                } else {
-                  const double a = (lo - p.x) / du, b = (hi - p.x) / du;
-                  t0 = std::max(t0, std::min(a, b));
-                  t1 = std::min(t1, std::max(a, b));
-                  if (t0 > t1) continue;
-                }
-                const double v0 = p.y + (q.y - p.y) * t0, v1 = p.y + (q.y - p.y) * t1;
-                v_lo = std::min({v_lo, v0, v1});
-                v_hi = std::max({v_hi, v0, v1});
-              }
-              AxisRange run;
-              if (v_lo <= v_hi && clip_range(d3, r[std::size_t(d3)], v_lo, v_hi, run)) {
-                at[d2] = t;
-                emit(at, d3, run);
-              }
-              if (t == rows.last) break;
+        const Slab& slab = slab_of(s);
+        // The piece's rows that the layer's polygon reaches, in its order.
+        const int t_lo = std::max(rows.lo(), slab.row_first);
+        const int t_hi = std::min(rows.hi(), slab.row_first + slab.rows - 1);
+        if (t_lo <= t_hi) {
+          const int t_first = rows.step > 0 ? t_lo : t_hi, t_last = rows.step > 0 ? t_hi : t_lo;
+          for (int t = t_first;; t += rows.step) {
+            const glm::ivec2 span = row_cells_[slab.offset + std::size_t(t - slab.row_first)];
+            const int v_lo = std::max(span.x, cols.lo()), v_hi = std::min(span.y, cols.hi());
+            if (v_lo <= v_hi) {
+              if (cols.step > 0) emit_row(s, t, v_lo, v_hi, 1);
+              else emit_row(s, t, v_hi, v_lo, -1);
             }
+            if (t == t_last) break;
           }
         }
       }
-      if (s == r[std::size_t(d)].last) break;
+      if (s == slices.last) break;
     }
   }
   return runs_;
