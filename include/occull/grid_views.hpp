@@ -39,10 +39,11 @@ namespace occull {
 /// missed), and growing durations only when the views' total demand
 /// exceeded the total rather than at each view's allowance (58 vs 23 for
 /// even, longest miss 5 frames, 16 % more queries). The misses are all in
-/// the turning view, in cells at the frustum's sides whose hidden answers
-/// the cap keeps stale: what would help is ordering a view's re-queries
-/// within its allowance, not the split. Policy::even is therefore GridViews'
-/// default.
+/// the turning view (path turn); a guess not yet checked: cells at the
+/// frustum's sides, hidden only because their visible part was outside it,
+/// whose answers the cap keeps stale while the view turns, so ordering a
+/// view's re-queries within its allowance may matter more than the split.
+/// Policy::even is therefore GridViews' default.
 ///
 /// Policy, once per frame (split()), from each view's last report:
 ///  - forced: the queries of drawn cells, which run past the cap anyway;
