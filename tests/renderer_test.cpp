@@ -1,5 +1,7 @@
 // GL integration tests: the reference renderer on llvmpipe (or any GL 4.5
 // driver), small frames.
+#include "gl/gl.hpp"
+#include "occull/error.hpp"
 #include "occull/gl/context.hpp"
 #include "occull/gl/renderer.hpp"
 #include "occull/harness.hpp"
@@ -527,4 +529,40 @@ TEST_F(RendererTest, ZeroThicknessBoxIsWidenedAlongItsWholeOutline) {
   r.end_frame();
   EXPECT_GE(n, 68u);  // as QueryOutlineWidensByTheMarginSideways
   EXPECT_LE(n, 80u);
+}
+
+// --gl-debug: a failing GL call becomes a GlError at the next check, naming
+// the phase, the driver's report and the failing call's stack.
+TEST(GlDebug, AFailingCallBecomesAGlErrorNamingThePhaseTheCallAndItsStack) {
+  gl::ContextOptions options;
+  options.debug = true;
+  auto context = gl::Context::create(options);
+  ASSERT_TRUE(context->debug());
+  EXPECT_NO_THROW(context->check("a quiet phase"));
+  glBindBuffer(GL_ARRAY_BUFFER, 0x7fffffffu);  // a name never generated: GL_INVALID_OPERATION
+  glBindBuffer(GL_ARRAY_BUFFER, 0x7ffffffeu);
+  try {
+    context->check("the test's phase");
+    FAIL() << "no GlError";
+  } catch (const GlError& e) {
+    const std::string text = e.what();
+    EXPECT_NE(text.find("during the test's phase"), std::string::npos) << text;
+    EXPECT_NE(text.find("glBindBuffer"), std::string::npos) << text;
+    EXPECT_NE(text.find("(and 1 more)"), std::string::npos) << text;
+    EXPECT_NE(text.find("AFailingCallBecomesAGlError"), std::string::npos) << "the stack names the caller: " << text;
+  }
+  // Reported once: the next check is quiet.
+  EXPECT_NO_THROW(context->check("after"));
+}
+
+TEST(GlDebug, ABenchRunWithGlDebugReportsNoErrors) {
+  BenchConfig config;
+  config.scene = "city:blocks=3,traffic=3";
+  config.algorithms = {"vfc", "chcpp", "grid", "oracle"};
+  config.frames = 3;
+  config.warmup = 1;
+  config.width = 96;
+  config.height = 54;
+  config.gl_debug = true;
+  EXPECT_NO_THROW((void)run_bench(config));
 }

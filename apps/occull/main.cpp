@@ -45,6 +45,10 @@ constexpr const char* kMallocHelp =
     "allocator policy of the process: engine (keep freed heap memory, as engines do, so driver batches do "
     "not page-fault it back in) or system (glibc's defaults)";
 
+constexpr const char* kGlDebugHelp =
+    "GL debug contexts: the driver checks every call, and a failing one stops the run with exit 1, "
+    "naming the call and its stack (slower: not for timings)";
+
 struct Size {
   int width = 1280;
   int height = 720;
@@ -218,6 +222,7 @@ struct BenchArgs {
   std::string malloc_policy = "engine";
   std::string suite;
   int views = 1;
+  bool gl_debug = false;
 };
 
 bool parse_on_off(const std::string& flag, const std::string& s) {
@@ -327,6 +332,7 @@ occull::BenchConfig bench_config(const BenchArgs& a) {
   c.query_raster = parse_query_raster(a.query_raster);
   c.query_margin_px = a.query_margin;
   c.multi_draw = parse_draw_mode(a.draw);
+  c.gl_debug = a.gl_debug;
   c.repeat = a.repeat;
   if (a.bvh_leaf < 1 || a.bvh_leaf > 64)
     throw occull::InputError(fmt::format("--bvh-leaf {}: must be in [1, 64]", a.bvh_leaf));
@@ -480,6 +486,7 @@ struct RenderArgs {
   std::string size = "1280x720";
   std::string out = "occull.png";
   std::vector<std::string> opts;
+  bool gl_debug = false;
 };
 
 int cmd_render(const RenderArgs& a) {
@@ -494,7 +501,9 @@ int cmd_render(const RenderArgs& a) {
   ropts.height = size.height;
   if (!(a.fps >= 0.0) || !(a.start >= 0.0))
     throw occull::InputError("--fps and --start must be numbers >= 0");
-  occull::Session session(a.scene, ropts);
+  occull::gl::ContextOptions copts;
+  copts.debug = a.gl_debug;
+  occull::Session session(a.scene, ropts, {}, copts);
   session.set_sampling({a.fps, a.start});
   const auto& path = session.path(a.path);
   if (a.frame >= path.frames_that_fit(session.sampling()))
@@ -534,6 +543,7 @@ void add_run_options(CLI::App* cmd, BenchArgs& a, const std::string& per) {
   cmd->add_option("--verify", a.verify, "check every frame against ground truth (on/off)")->capture_default_str();
   cmd->add_option("--json", a.json, "write the results as JSON to this file");
   cmd->add_option("--malloc", a.malloc_policy, kMallocHelp)->capture_default_str();
+  cmd->add_flag("--gl-debug", a.gl_debug, kGlDebugHelp);
 }
 
 struct TraverseArgs {
@@ -693,6 +703,7 @@ int main(int argc, char** argv) {
   r->add_option("--size", render.size, "image size WIDTHxHEIGHT")->capture_default_str();
   r->add_option("--out", render.out, "output PNG file")->capture_default_str();
   r->add_option("--opt", render.opts, "algorithm option algo.key=value (repeatable)");
+  r->add_flag("--gl-debug", render.gl_debug, kGlDebugHelp);
 
   TraverseArgs traverse;
   auto* tv = app.add_subcommand("traverse",
@@ -744,6 +755,9 @@ int main(int argc, char** argv) {
     std::cerr << "occull: no usable OpenGL: " << e.what() << "\n";
     return kExitNoGl;
   } catch (const occull::InvariantViolation& e) {
+    std::cerr << "occull: " << e.what() << "\n";
+    return kExitInternal;
+  } catch (const occull::GlError& e) {
     std::cerr << "occull: " << e.what() << "\n";
     return kExitInternal;
   } catch (const std::exception& e) {

@@ -31,4 +31,14 @@ class InvariantViolation : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+/// An OpenGL call failed, as the driver's debug output reported it (a
+/// context created with ContextOptions::debug, occull --gl-debug, or any
+/// context of a debug build): a bug in occull or in the driver. The message
+/// names the phase, the driver's report and the call stack of the failing
+/// call. Tools map it to exit code 1.
+class GlError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
 }  // namespace occull

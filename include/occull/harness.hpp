@@ -118,7 +118,7 @@ class Session {
   /// Builds the scene from `scene_spec` (throws InputError) and its BVH,
   /// then creates the GL context (throws GlUnavailable) and the renderer.
   Session(std::string_view scene_spec, const gl::RendererOptions& renderer_options,
-          const BvhOptions& bvh_options = {});
+          const BvhOptions& bvh_options = {}, const gl::ContextOptions& context_options = {});
   ~Session();
   Session(const Session&) = delete;
   Session& operator=(const Session&) = delete;
@@ -216,6 +216,7 @@ class Session {
   std::unique_ptr<gl::Context> context_;
   gl::DeviceInfo device_;
   gl::RendererOptions renderer_options_;
+  gl::ContextOptions context_options_;
   std::unique_ptr<gl::Renderer> renderer_;
   std::optional<HardwareProfile> profile_;
   FaultHooks hooks_;
@@ -247,6 +248,7 @@ struct BenchConfig {
   bool multi_draw = false;                ///< see gl::RendererOptions::multi_draw
   BvhOptions bvh;                         ///< how the scene's hierarchy is built
   bool model = false;                     ///< also predict each frame with the NOHC cost model
+  bool gl_debug = false;                  ///< GL debug contexts: a failing GL call stops the run (gl::ContextOptions)
   std::string allocator;                  ///< the process's allocator policy, as the report names it (apply_allocator_policy)
   FaultHooks hooks;                       ///< tests only: break a step on purpose (see FaultHooks)
 };

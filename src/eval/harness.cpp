@@ -88,12 +88,13 @@ std::vector<ObjectId> check_frame(std::span<const gl::Renderer::ObjectPixels> tr
 
 // The scene first: a bad spec is reported before any GL work.
 Session::Session(std::string_view scene_spec, const gl::RendererOptions& renderer_options,
-                 const BvhOptions& bvh_options)
-    : scene_spec_(scene_spec), bundle_(timed_make_scene(scene_spec, scene_build_ms_)) {
+                 const BvhOptions& bvh_options, const gl::ContextOptions& context_options)
+    : scene_spec_(scene_spec), bundle_(timed_make_scene(scene_spec, scene_build_ms_)),
+      context_options_(context_options) {
   const auto t0 = Clock::now();
   bvh_ = Bvh::build(bundle_.scene, bvh_options);
   bvh_build_ms_ = ms_between(t0, Clock::now());
-  context_ = gl::Context::create();
+  context_ = gl::Context::create(context_options_);
   device_ = context_->info();
   renderer_options_ = renderer_options;
   renderer_ = std::make_unique<gl::Renderer>(bundle_.scene, renderer_options);
@@ -102,7 +103,7 @@ Session::Session(std::string_view scene_spec, const gl::RendererOptions& rendere
 void Session::reset_renderer() {
   renderer_.reset();
   context_.reset();
-  context_ = gl::Context::create();
+  context_ = gl::Context::create(context_options_);
   renderer_ = std::make_unique<gl::Renderer>(bundle_.scene, renderer_options_);
 }
 
@@ -139,6 +140,7 @@ FrameStats Session::run_frame(Culler& culler, const View& view, double time_s) {
   FrameStats s = culler.render_frame(view, *renderer_);
   const auto c1 = Clock::now();
   const BackendStats during = renderer_->stats() - before;
+  context_->check("a culler's frame");  // before end_frame's own glGetError, which knows less
   s.gpu_ms = renderer_->end_frame();
   const auto t1 = Clock::now();
   const ProcessUsage u1 = process_usage();
@@ -161,6 +163,7 @@ FrameStats Session::run_frame(Culler& culler, const View& view, double time_s) {
   s.objects_rendered = d.objects_rendered;
   s.conditional_objects = d.conditional_objects;
   s.conditional_skipped = d.conditional_skipped;
+  context_->check("the end of a frame");
   culler.frame_finished(s);
   return s;
 }
@@ -195,6 +198,7 @@ std::vector<FrameTruth> Session::ground_truth(const CameraPath& path, int frames
       if (!drawn[id] && !scene.material(objects[id].material).translucent) outside.push_back(id);
     const std::uint64_t outside_samples = renderer_->samples_in_front(view, outside);
 
+    context_->check("the ground truth");
     std::sort(in_frustum.begin(), in_frustum.end());
     detail::check_truth_in_frustum(where, t.visible, in_frustum);
     detail::check_truth_covers_full_render(where, images.ids, images.depth, outside_samples);
@@ -604,7 +608,9 @@ BenchResult run_bench(const BenchConfig& config, const ProgressFn& progress) {
                                  config.sampling.fps));
   if (config.sampling.start_s < 0.0 || !std::isfinite(config.sampling.start_s))
     throw InputError(fmt::format("--start {}: must be a number of seconds >= 0", config.sampling.start_s));
-  Session session(config.scene, ropts, config.bvh);
+  gl::ContextOptions copts;
+  copts.debug = config.gl_debug;
+  Session session(config.scene, ropts, config.bvh, copts);
   session.set_fault_hooks(config.hooks);
   session.set_sampling(config.sampling);
   // The path of each view: those named, else the scene's paths in turn.

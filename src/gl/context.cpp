@@ -7,7 +7,10 @@
 #include <EGL/eglext.h>
 #include <fmt/format.h>
 
+#include <cstdlib>
 #include <cstring>
+#include <cxxabi.h>
+#include <execinfo.h>
 #include <string_view>
 
 namespace occull::gl {
@@ -63,10 +66,38 @@ EGLDisplay open_display(std::string& platform) {
       kInstallHint));
 }
 
+#ifndef EGL_CONTEXT_OPENGL_DEBUG
+#define EGL_CONTEXT_OPENGL_DEBUG 0x31B0
+#endif
+
+void GLAPIENTRY debug_callback(GLenum /*source*/, GLenum type, GLuint id, GLenum /*severity*/, GLsizei /*length*/,
+                               const GLchar* message, const void* context) {
+  static_cast<Context*>(const_cast<void*>(context))->on_report(type, id, message);
+}
+
+// "module(mangled+0x2f) [0x...]" as "module: demangled +0x2f" where the
+// symbol demangles; as it was otherwise.
+std::string readable_frame(const char* frame) {
+  const std::string_view f(frame);
+  const std::size_t open = f.find('('), plus = f.find('+', open), close = f.find(')', open);
+  if (open == f.npos || plus == f.npos || close == f.npos || plus == open + 1 || plus > close) return std::string(f);
+  const std::string mangled(f.substr(open + 1, plus - open - 1));
+  int status = 0;
+  char* name = abi::__cxa_demangle(mangled.c_str(), nullptr, nullptr, &status);
+  std::string out = status == 0 && name ? fmt::format("{}: {} {}", f.substr(0, open), name, f.substr(plus, close - plus))
+                                        : std::string(f);
+  std::free(name);
+  return out;
+}
+
 }  // namespace
 
-std::unique_ptr<Context> Context::create() {
+std::unique_ptr<Context> Context::create(const ContextOptions& options) {
   std::unique_ptr<Context> self(new Context());
+  self->debug_ = options.debug;
+#ifndef NDEBUG
+  self->debug_ = true;
+#endif
   EGLDisplay display = open_display(self->platform_);
   self->display_ = display;
   if (!eglBindAPI(EGL_OPENGL_API)) {
@@ -82,9 +113,11 @@ std::unique_ptr<Context> Context::create() {
       throw GlUnavailable(fmt::format("EGL offers no OpenGL config: {}", kInstallHint));
     config = nullptr;  // EGL_NO_CONFIG_KHR
   }
-  const EGLint context_attribs[] = {EGL_CONTEXT_MAJOR_VERSION, 4, EGL_CONTEXT_MINOR_VERSION, 5,
-                                    EGL_CONTEXT_OPENGL_PROFILE_MASK,
-                                    EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT, EGL_NONE};
+  const EGLint context_attribs[] = {EGL_CONTEXT_MAJOR_VERSION,       4,
+                                    EGL_CONTEXT_MINOR_VERSION,       5,
+                                    EGL_CONTEXT_OPENGL_PROFILE_MASK, EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT,
+                                    EGL_CONTEXT_OPENGL_DEBUG,        self->debug_ ? EGL_TRUE : EGL_FALSE,
+                                    EGL_NONE};
   EGLContext context = eglCreateContext(display, config, EGL_NO_CONTEXT, context_attribs);
   if (context == EGL_NO_CONTEXT)
     throw GlUnavailable(fmt::format(
@@ -103,7 +136,41 @@ std::unique_ptr<Context> Context::create() {
   if (gl_major * 10 + gl_minor < 45)
     throw GlUnavailable(fmt::format("the context is OpenGL {}.{}; occull needs 4.5 core",
                                     gl_major, gl_minor));
+  if (self->debug_) {
+    // Synchronous: the driver reports inside the failing call, so its call
+    // stack is the caller's.
+    glEnable(GL_DEBUG_OUTPUT);
+    glEnable(GL_DEBUG_OUTPUT_SYNCHRONOUS);
+    glDebugMessageCallback(debug_callback, self.get());
+    glDebugMessageControl(GL_DONT_CARE, GL_DONT_CARE, GL_DONT_CARE, 0, nullptr, GL_TRUE);
+  }
   return self;
+}
+
+void Context::on_report(unsigned type, unsigned id, const char* message) noexcept {
+  // Performance and portability notes are not failures.
+  if (type != GL_DEBUG_TYPE_ERROR && type != GL_DEBUG_TYPE_UNDEFINED_BEHAVIOR) return;
+  if (errors_++ > 0) return;
+  try {
+    first_error_ = fmt::format("{} (id {})", message ? message : "(no message)", id);
+  } catch (...) {
+    first_error_.clear();
+  }
+  stack_depth_ = backtrace(stack_.data(), int(stack_.size()));
+}
+
+void Context::check(std::string_view where) {
+  if (errors_ == 0) return;
+  std::string text = fmt::format("OpenGL error during {}: {}", where, first_error_);
+  if (errors_ > 1) text += fmt::format(" (and {} more)", errors_ - 1);
+  text += "; the failing call's stack:";
+  char** names = backtrace_symbols(stack_.data(), stack_depth_);
+  // The first frames are on_report and the callback: skipped.
+  for (int i = 1; names && i < stack_depth_; ++i) text += fmt::format("\n  {}", readable_frame(names[i]));
+  std::free(names);
+  errors_ = 0;
+  first_error_.clear();
+  throw GlError(text);
 }
 
 Context::~Context() {

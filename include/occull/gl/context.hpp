@@ -1,8 +1,10 @@
 // occull — a headless OpenGL 4.5 core context (EGL, no window, no X server).
 #pragma once
 
+#include <array>
 #include <memory>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace occull::gl {
@@ -23,6 +25,16 @@ struct DeviceInfo {
   std::vector<std::string> culling_extensions;
 };
 
+/// How to create a Context.
+struct ContextOptions {
+  /// A debug context whose driver reports every failing GL call (KHR_debug,
+  /// synchronous: the report is made inside the failing call, whose call
+  /// stack is kept); Context::check() turns the first report into a
+  /// GlError. Costs driver time: off for benchmarks. Always on in a debug
+  /// build of occull (NDEBUG not defined when the library was compiled).
+  bool debug = false;
+};
+
 /// Owns an OpenGL 4.5 core context on the process's headless EGL display,
 /// current on the creating thread for the object's lifetime. Not copyable;
 /// one per thread. The display stays initialised after the last Context is
@@ -32,15 +44,32 @@ class Context {
   /// Creates the context: Mesa's surfaceless platform first, the EGL device
   /// platform as fallback. Throws GlUnavailable with a message that names
   /// what is missing (EGL library, platform, OpenGL 4.5 core support).
-  static std::unique_ptr<Context> create();
+  static std::unique_ptr<Context> create(const ContextOptions& options = {});
   ~Context();
   Context(const Context&) = delete;
   Context& operator=(const Context&) = delete;
 
   [[nodiscard]] DeviceInfo info() const;
 
+  /// Whether the driver reports failing calls (ContextOptions::debug).
+  [[nodiscard]] bool debug() const noexcept { return debug_; }
+  /// Throws GlError if a GL call on this context failed since the last
+  /// check, naming `where` (the phase the caller was in), the driver's first
+  /// report, how many followed, and the failing call's stack; then forgets
+  /// them. Without debug output it does nothing. Cheap when nothing failed.
+  void check(std::string_view where);
+
+  /// What the driver reported (called by it, synchronously, on the thread
+  /// of the failing call). Not for callers.
+  void on_report(unsigned type, unsigned id, const char* message) noexcept;
+
  private:
   Context() = default;
+  bool debug_ = false;
+  int errors_ = 0;              // failed calls reported since the last check()
+  std::string first_error_;     // the first one's report
+  std::array<void*, 24> stack_{};  // the first one's call stack
+  int stack_depth_ = 0;
   void* display_ = nullptr;
   void* context_ = nullptr;
   std::string platform_;
