@@ -2,11 +2,13 @@
 #   make demo   install dependencies, build (Release), run the main benchmark
 #   make test   install dependencies, build, run every test (ctest)
 #   make test-asan   the same tests built with AddressSanitizer, LeakSanitizer and UBSan
+#   make fuzz   fuzz every file reader for FUZZ_SECONDS each (libFuzzer, clang; build-fuzz/)
+#   make fuzz-regress   every reader over its corpus in tests/corpus/, then briefly fuzzed (CI)
 BUILD ?= build
 JOBS ?= $(shell nproc)
 CMAKE_FLAGS ?=
 
-.PHONY: demo test test-asan deps data configure build install clean gpu-pack
+.PHONY: demo test test-asan fuzz fuzz-regress fuzz-build deps data configure build install clean gpu-pack
 
 demo: build
 	./$(BUILD)/occull bench
@@ -19,6 +21,20 @@ test-asan: deps data
 	cmake -S . -B $(BUILD)-asan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DOCCULL_SANITIZE=ON $(CMAKE_FLAGS)
 	cmake --build $(BUILD)-asan -j $(JOBS)
 	cd $(BUILD)-asan && ctest --output-on-failure -j $(JOBS)
+
+# The readers of files made by others under libFuzzer, with ASan and UBSan.
+FUZZ_SECONDS ?= 60
+fuzz-build:
+	./scripts/install-deps.sh --fuzz
+	cmake -S . -B $(BUILD)-fuzz -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_COMPILER=clang++-14 \
+	  -DOCCULL_FUZZ=ON -DOCCULL_BUILD_TESTS=OFF -DOCCULL_BUILD_APPS=OFF $(CMAKE_FLAGS)
+	cmake --build $(BUILD)-fuzz -j $(JOBS) --target fuzz_bsp fuzz_pk3 fuzz_path fuzz_profile fuzz_scene_spec fuzz_model
+
+fuzz: fuzz-build
+	./scripts/fuzz.sh $(BUILD)-fuzz run $(FUZZ_SECONDS)
+
+fuzz-regress: fuzz-build
+	./scripts/fuzz.sh $(BUILD)-fuzz regress
 
 deps:
 	./scripts/install-deps.sh
@@ -43,4 +59,4 @@ gpu-pack: deps
 	./scripts/gpu-pack.sh .gpu
 
 clean:
-	rm -rf $(BUILD) $(BUILD)-asan
+	rm -rf $(BUILD) $(BUILD)-asan $(BUILD)-fuzz

@@ -2,6 +2,7 @@
 # Installs what occull needs to build, test and run on Debian 12, with
 # apt-get, only for packages that are missing. Idempotent: a second run
 # installs nothing. Runs as root, or through sudo when it is available.
+# --fuzz adds the fuzzing toolchain (make fuzz).
 set -euo pipefail
 
 packages=(
@@ -15,6 +16,10 @@ packages=(
   # tests and benchmarks
   libgtest-dev libgmock-dev libbenchmark-dev
 )
+# --fuzz: also what make fuzz needs (clang and its libFuzzer runtime).
+if [[ "${1:-}" == "--fuzz" ]]; then
+  packages+=(clang-14 libclang-rt-14-dev)
+fi
 
 missing=()
 for p in "${packages[@]}"; do

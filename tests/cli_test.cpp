@@ -60,10 +60,10 @@ TEST(Cli, HelpOnEveryCommandNamesItsOptions) {
       {"path", {"--scene", "--path", "--out"}},
       {"bench", {"--scene", "--path", "--algo", "--frames", "--fps", "--start", "--size", "--query-mode",
                  "--query-raster", "--query-margin", "--draw", "--verify", "--repeat", "--model", "--json",
-                 "--suite", "--malloc", "--views"}},
+                 "--suite", "--malloc", "--views", "--gl-debug"}},
       {"calibrate", {"--size", "--repeats", "--out", "--check"}},
       {"sweep", {"--algo", "--vary", "--baseline", "--popping", "--longest", "--scene", "--frames", "--json"}},
-      {"render", {"--scene", "--frame", "--fps", "--out"}},
+      {"render", {"--scene", "--frame", "--fps", "--out", "--gl-debug"}},
       {"traverse", {"--dims", "--views", "--mode", "--fov", "--seed"}}};
   for (const auto& [cmd, options] : commands) {
     const CliRun r = run(cmd + " --help");

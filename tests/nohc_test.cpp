@@ -230,6 +230,12 @@ TEST(Profile, CorruptFilesSayWhatIsWrong) {
   EXPECT_NE(error(without("\"query_setup_ms\": 0.02", "\"query_setup_ms\": -1")).find("query_setup_ms"),
             std::string::npos);
   EXPECT_NE(error("[]").find("not an object"), std::string::npos);
+  // Found by fuzz_profile: a number too large for a double escaped as nlohmann's out_of_range.
+  EXPECT_NE(error("[[3E967,,]").find("p.json: not a JSON"), std::string::npos);
+  std::string wide = text;  // a width that int cannot hold
+  const std::size_t digits = wide.find_first_of("0123456789", wide.find("\"size\""));
+  wide.replace(digits, wide.find_first_not_of("0123456789", digits) - digits, "4294967297");
+  EXPECT_NE(error(wide).find("\"size\" must be in [1, 16384]"), std::string::npos) << wide;
 }
 
 TEST(Profile, CachePathNamesTheRenderer) {

@@ -7,6 +7,7 @@
 
 #include <cctype>
 #include <cmath>
+#include <cstdint>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -52,7 +53,7 @@ HardwareProfile profile_from_json(std::string_view text, std::string_view source
   json doc;
   try {
     doc = json::parse(text);
-  } catch (const json::parse_error& e) {
+  } catch (const json::exception& e) {  // a syntax error, or a number out of range (fuzz_profile)
     throw InputError(fmt::format("{}: not a JSON hardware profile ({})", source, e.what()));
   }
   const auto fail = [&](const std::string& what) {
@@ -65,9 +66,10 @@ HardwareProfile profile_from_json(std::string_view text, std::string_view source
   if (!doc.contains("size") || !doc["size"].is_array() || doc["size"].size() != 2 ||
       !doc["size"][0].is_number_integer() || !doc["size"][1].is_number_integer())
     throw fail("\"size\" is not [width, height]");
-  p.width = doc["size"][0].get<int>();
-  p.height = doc["size"][1].get<int>();
-  if (p.width <= 0 || p.height <= 0) throw fail("\"size\" must be positive");
+  const auto w = doc["size"][0].get<std::int64_t>(), h = doc["size"][1].get<std::int64_t>();
+  if (w < 1 || h < 1 || w > 16384 || h > 16384) throw fail("\"size\" must be in [1, 16384] pixels per side");
+  p.width = int(w);
+  p.height = int(h);
   for (const char* key : kTimes) {
     if (!doc.contains(key) || !doc[key].is_number()) throw fail(fmt::format("no number \"{}\"", key));
     const double v = doc[key].get<double>();

@@ -82,9 +82,9 @@ const CameraPath& SceneBundle::path(std::string_view name) const {
   throw InputError(fmt::format("unknown path '{}' for scene {}; valid paths: {}", name, scene.name(), names));
 }
 
-SceneBundle make_scene(std::string_view spec) {
-  if (spec.rfind("q3:", 0) == 0) return q3::load(spec.substr(3));
-  if (spec.rfind("file:", 0) == 0) return scenes::load_model_file(std::string(spec.substr(5)));
+namespace scenes {
+
+ParsedSpec parse_spec(std::string_view spec) {
   const auto colon = spec.find(':');
   const std::string_view name = spec.substr(0, colon);
   const Generator* gen = nullptr;
@@ -95,7 +95,8 @@ SceneBundle make_scene(std::string_view spec) {
                                  "file:MODEL)",
                                  name, scene_names()));
 
-  scenes::Params params;
+  ParsedSpec parsed{&gen->info, {}, gen->make};
+  Params& params = parsed.params;
   for (const auto& p : gen->info.params) params[p.key] = p.default_value;
   std::string_view rest = colon == std::string_view::npos ? std::string_view{} : spec.substr(colon + 1);
   while (!rest.empty()) {
@@ -115,7 +116,16 @@ SceneBundle make_scene(std::string_view spec) {
                                    gen->info.name, key, param_names(gen->info)));
     params[info->key] = parse_number(item.substr(eq + 1), gen->info, *info);
   }
-  return gen->make(params);
+  return parsed;
+}
+
+}  // namespace scenes
+
+SceneBundle make_scene(std::string_view spec) {
+  if (spec.rfind("q3:", 0) == 0) return q3::load(spec.substr(3));
+  if (spec.rfind("file:", 0) == 0) return scenes::load_model_file(std::string(spec.substr(5)));
+  const scenes::ParsedSpec parsed = scenes::parse_spec(spec);
+  return parsed.make(parsed.params);
 }
 
 }  // namespace occull

@@ -11,6 +11,18 @@ namespace occull::scenes {
 /// Every parameter of a scene, defaults filled in, checked against its range.
 using Params = std::map<std::string, double>;
 
+/// An embedded scene's spec "name[:key=value,...]", parsed: the scene and
+/// every parameter (defaults filled in, each checked against its range).
+struct ParsedSpec {
+  const SceneInfo* info = nullptr;
+  Params params;
+  SceneBundle (*make)(const Params&) = nullptr;
+};
+/// Throws InputError naming the fault (an unknown scene lists the valid
+/// ones, an unknown parameter the scene's). Precondition: spec is not a
+/// q3: or file: spec.
+[[nodiscard]] ParsedSpec parse_spec(std::string_view spec);
+
 SceneInfo city_info();
 SceneBundle make_city(const Params& params);
 
