@@ -60,7 +60,7 @@ TEST(Cli, HelpOnEveryCommandNamesItsOptions) {
       {"path", {"--scene", "--path", "--out"}},
       {"bench", {"--scene", "--path", "--algo", "--frames", "--fps", "--start", "--size", "--query-mode",
                  "--query-raster", "--query-margin", "--draw", "--verify", "--repeat", "--model", "--json",
-                 "--suite", "--malloc", "--views", "--gl-debug"}},
+                 "--suite", "--malloc", "--views", "--gl-debug", "--stall-guard"}},
       {"calibrate", {"--size", "--repeats", "--out", "--check"}},
       {"sweep", {"--algo", "--vary", "--baseline", "--popping", "--longest", "--scene", "--frames", "--json"}},
       {"render", {"--scene", "--frame", "--fps", "--out", "--gl-debug"}},
@@ -492,6 +492,14 @@ TEST(Cli, SweepOfAnUnknownOptionListsTheValidOnes) {
   EXPECT_NE(r.output.find("valid options: cell, traversal, cap"), std::string::npos) << r.output;
   const CliRun two = run("sweep --algo grid,vfc --vary cap=1");
   EXPECT_EQ(two.code, 2) << two.output;
+}
+
+TEST(Cli, StallGuardKeepsConservativeCullersConservativeAndRejectsNegativeTimes) {
+  const CliRun r = run(std::string("bench ") + kTinyCity + " --algo vfc,chcpp,stopwait --frames 4 --warmup 1 "
+                       "--stall-guard 0.001");
+  EXPECT_EQ(r.code, 0) << r.output;  // 4 would mean a conservative culler missed an object
+  EXPECT_NE(r.output.find("verification passed"), std::string::npos) << r.output;
+  EXPECT_EQ(run("bench --stall-guard -1 --frames 1").code, 2);
 }
 
 TEST(Cli, TraverseTimesTheGridTraversalAndRejectsBadDimensions) {

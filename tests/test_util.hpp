@@ -97,8 +97,12 @@ class RecordingBackend final : public Backend {
     return QueryId(results_.size() - 1);
   }
   bool result_available(QueryId q) override { return available(q); }
-  std::uint64_t result(QueryId q) override { return results_.at(q); }
+  std::uint64_t result(QueryId q) override {
+    read.push_back(q);
+    return results_.at(q);
+  }
   [[nodiscard]] BackendStats stats() const override { return stats_; }
+  std::vector<QueryId> read;  ///< queries whose result() was called, in order
 
  private:
   std::vector<std::uint64_t> results_;

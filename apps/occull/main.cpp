@@ -223,6 +223,7 @@ struct BenchArgs {
   std::string suite;
   int views = 1;
   bool gl_debug = false;
+  double stall_guard = 0.0;
 };
 
 bool parse_on_off(const std::string& flag, const std::string& s) {
@@ -333,6 +334,7 @@ occull::BenchConfig bench_config(const BenchArgs& a) {
   c.query_margin_px = a.query_margin;
   c.multi_draw = parse_draw_mode(a.draw);
   c.gl_debug = a.gl_debug;
+  c.stall_guard_ms = a.stall_guard;
   c.repeat = a.repeat;
   if (a.bvh_leaf < 1 || a.bvh_leaf > 64)
     throw occull::InputError(fmt::format("--bvh-leaf {}: must be in [1, 64]", a.bvh_leaf));
@@ -544,6 +546,10 @@ void add_run_options(CLI::App* cmd, BenchArgs& a, const std::string& per) {
   cmd->add_option("--json", a.json, "write the results as JSON to this file");
   cmd->add_option("--malloc", a.malloc_policy, kMallocHelp)->capture_default_str();
   cmd->add_flag("--gl-debug", a.gl_debug, kGlDebugHelp);
+  cmd->add_option("--stall-guard", a.stall_guard,
+                  "milliseconds a culler waits for a query result before taking it as visible, as engines "
+                  "guard against a driver that never answers (0: wait; counted as stalled per frame)")
+      ->capture_default_str();
 }
 
 struct TraverseArgs {

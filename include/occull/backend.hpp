@@ -35,6 +35,7 @@ struct BackendStats {
   std::uint64_t flushes = 0;
   std::uint64_t conditional_objects = 0;  ///< opaque objects drawn by render_conditional()
   std::uint64_t conditional_skipped = 0;  ///< ... of them whose query passed no samples (device skipped them)
+  std::uint64_t stalled_results = 0;   ///< results given up on and taken as visible (StallGuard)
   double wait_ms = 0.0;                ///< wall time blocked inside result(), milliseconds
   double backend_ms = 0.0;             ///< wall time inside any Backend call, milliseconds
 
@@ -45,6 +46,7 @@ struct BackendStats {
             a.state_changes - b.state_changes, a.material_changes - b.material_changes,
             a.blocking_waits - b.blocking_waits, a.flushes - b.flushes,
             a.conditional_objects - b.conditional_objects, a.conditional_skipped - b.conditional_skipped,
+            a.stalled_results - b.stalled_results,
             a.wait_ms - b.wait_ms,             a.backend_ms - b.backend_ms};
   }
 };

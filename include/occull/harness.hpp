@@ -23,6 +23,7 @@
 #include "occull/gl/context.hpp"
 #include "occull/gl/renderer.hpp"
 #include "occull/scenes.hpp"
+#include "occull/stall_guard.hpp"
 #include "occull/stats.hpp"
 
 #include <functional>
@@ -188,6 +189,13 @@ class Session {
   /// valid names, or naming what is wrong in the file.
   const CameraPath& path(std::string_view name);
 
+  /// Culler frames get the renderer through a StallGuard of this many
+  /// milliseconds (0, the default: none, results are waited for).
+  /// Precondition: timeout_ms >= 0.
+  void set_stall_guard(double timeout_ms);
+  /// What culler frames render through: the renderer, or its StallGuard.
+  [[nodiscard]] Backend& backend() noexcept;
+
   /// Where frames lie on paths (default: spread over the whole path).
   void set_sampling(const FrameSampling& sampling) { sampling_ = sampling; }
   [[nodiscard]] const FrameSampling& sampling() const noexcept { return sampling_; }
@@ -218,6 +226,8 @@ class Session {
   gl::RendererOptions renderer_options_;
   gl::ContextOptions context_options_;
   std::unique_ptr<gl::Renderer> renderer_;
+  double stall_guard_ms_ = 0.0;
+  std::unique_ptr<StallGuard> guard_;  // over renderer_; goes before it
   std::optional<HardwareProfile> profile_;
   FaultHooks hooks_;
   FrameSampling sampling_;
@@ -249,6 +259,7 @@ struct BenchConfig {
   BvhOptions bvh;                         ///< how the scene's hierarchy is built
   bool model = false;                     ///< also predict each frame with the NOHC cost model
   bool gl_debug = false;                  ///< GL debug contexts: a failing GL call stops the run (gl::ContextOptions)
+  double stall_guard_ms = 0.0;            ///< > 0: results not there within this time count as visible (StallGuard)
   std::string allocator;                  ///< the process's allocator policy, as the report names it (apply_allocator_policy)
   FaultHooks hooks;                       ///< tests only: break a step on purpose (see FaultHooks)
 };
@@ -284,6 +295,7 @@ struct AlgorithmSummary {
   double objects_rendered_per_frame = 0.0;
   double conditional_objects_per_frame = 0.0;  ///< drawn under conditional rendering (FrameStats)
   double conditional_skipped_per_frame = 0.0;  ///< ... skipped by the device (FrameStats)
+  double stalled_per_frame = 0.0;  ///< query results given up on by --stall-guard (FrameStats::stalled)
   double nodes_visited_per_frame = 0.0;
   double extra_objects_per_frame = 0.0;  ///< over-rendering (verified runs)
   double wait_ms_per_frame = 0.0;

@@ -48,6 +48,7 @@ struct FrameStats {
   std::uint64_t objects_rendered = 0;
   std::uint64_t conditional_objects = 0;  ///< objects drawn under conditional rendering (in objects_rendered)
   std::uint64_t conditional_skipped = 0;  ///< ... that the device skipped: their query found no samples
+  std::uint64_t stalled = 0;     ///< query results given up on and taken as visible (StallGuard, --stall-guard)
 
   // Verification against the frame's ground truth (all 0 when not verified).
   std::uint32_t truth_objects = 0;   ///< objects with a visible pixel in the ground truth

@@ -100,14 +100,27 @@ Session::Session(std::string_view scene_spec, const gl::RendererOptions& rendere
   renderer_ = std::make_unique<gl::Renderer>(bundle_.scene, renderer_options);
 }
 
+void Session::set_stall_guard(double timeout_ms) {
+  stall_guard_ms_ = timeout_ms;
+  guard_ = timeout_ms > 0.0 ? std::make_unique<StallGuard>(*renderer_, timeout_ms) : nullptr;
+}
+
+Backend& Session::backend() noexcept {
+  if (guard_) return *guard_;
+  return *renderer_;
+}
+
 void Session::reset_renderer() {
+  guard_.reset();
   renderer_.reset();
   context_.reset();
   context_ = gl::Context::create(context_options_);
   renderer_ = std::make_unique<gl::Renderer>(bundle_.scene, renderer_options_);
+  set_stall_guard(stall_guard_ms_);
 }
 
 Session::~Session() {
+  guard_.reset();     // reads the queries it gave up on
   renderer_.reset();  // GL objects go before the context
   context_.reset();
 }
@@ -135,16 +148,17 @@ FrameStats Session::run_frame(Culler& culler, const View& view, double time_s) {
   const auto t0 = Clock::now();
   bvh_.refit(bundle_.scene);
   renderer_->begin_frame(view);
-  const BackendStats before = renderer_->stats();
+  Backend& backend = this->backend();
+  const BackendStats before = backend.stats();
   const auto c0 = Clock::now();
-  FrameStats s = culler.render_frame(view, *renderer_);
+  FrameStats s = culler.render_frame(view, backend);
   const auto c1 = Clock::now();
-  const BackendStats during = renderer_->stats() - before;
+  const BackendStats during = backend.stats() - before;
   context_->check("a culler's frame");  // before end_frame's own glGetError, which knows less
   s.gpu_ms = renderer_->end_frame();
   const auto t1 = Clock::now();
   const ProcessUsage u1 = process_usage();
-  const BackendStats d = renderer_->stats() - before;
+  const BackendStats d = backend.stats() - before;
   s.minor_faults = u1.minor_faults - u0.minor_faults;
   s.major_faults = u1.major_faults - u0.major_faults;
   s.kernel_ms = u1.kernel_ms - u0.kernel_ms;
@@ -163,6 +177,7 @@ FrameStats Session::run_frame(Culler& culler, const View& view, double time_s) {
   s.objects_rendered = d.objects_rendered;
   s.conditional_objects = d.conditional_objects;
   s.conditional_skipped = d.conditional_skipped;
+  s.stalled = d.stalled_results;
   context_->check("the end of a frame");
   culler.frame_finished(s);
   return s;
@@ -375,6 +390,7 @@ std::vector<AlgorithmSummary> summarize_runs(std::span<const AlgorithmRun> runs)
         sums["objects_rendered"] += double(f.objects_rendered);
         sums["conditional_objects"] += double(f.conditional_objects);
         sums["conditional_skipped"] += double(f.conditional_skipped);
+        sums["stalled"] += double(f.stalled);
         sums["nodes_visited"] += double(f.nodes_visited);
         sums["extra_objects"] += double(f.extra_objects);
         sums["wait_ms"] += f.wait_ms;
@@ -437,6 +453,7 @@ std::vector<AlgorithmSummary> summarize_runs(std::span<const AlgorithmRun> runs)
     a.objects_rendered_per_frame = med("objects_rendered");
     a.conditional_objects_per_frame = med("conditional_objects");
     a.conditional_skipped_per_frame = med("conditional_skipped");
+    a.stalled_per_frame = med("stalled");
     a.nodes_visited_per_frame = med("nodes_visited");
     a.extra_objects_per_frame = med("extra_objects");
     a.wait_ms_per_frame = med("wait_ms");
@@ -494,6 +511,7 @@ void add_view(FrameStats& sum, const FrameStats& v) {
   sum.objects_rendered += v.objects_rendered;
   sum.conditional_objects += v.conditional_objects;
   sum.conditional_skipped += v.conditional_skipped;
+  sum.stalled += v.stalled;
   sum.truth_objects += v.truth_objects;
   sum.missed_objects += v.missed_objects;
   sum.wrong_pixels += v.wrong_pixels;
@@ -613,6 +631,10 @@ BenchResult run_bench(const BenchConfig& config, const ProgressFn& progress) {
   Session session(config.scene, ropts, config.bvh, copts);
   session.set_fault_hooks(config.hooks);
   session.set_sampling(config.sampling);
+  if (!(config.stall_guard_ms >= 0.0) || !std::isfinite(config.stall_guard_ms))
+    throw InputError(fmt::format("stall guard {} ms: must be a number of milliseconds >= 0 (0: off)",
+                                 config.stall_guard_ms));
+  session.set_stall_guard(config.stall_guard_ms);
   // The path of each view: those named, else the scene's paths in turn.
   std::vector<const CameraPath*> paths;
   for (int k = 0; k < config.views; ++k) {

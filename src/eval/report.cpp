@@ -137,6 +137,10 @@ void print_table(const BenchResult& r, std::ostream& out) {
       out << fmt::format("{}: {:.2f} hidden cells per frame found visible by their query and drawn in the same "
                          "frame (latency 0)\n",
                          a.name, a.revealed_per_frame);
+    if (a.stalled_per_frame > 0)
+      out << fmt::format("{}: {:.2f} query results per frame not there within the stall guard's time, taken as "
+                         "visible\n",
+                         a.name, a.stalled_per_frame);
     if (a.conditional_objects_per_frame > 0)
       out << fmt::format("{}: {:.1f} objects per frame drawn under conditional rendering, {:.1f} of them skipped "
                          "by the device (their query found them hidden)\n",
@@ -227,6 +231,7 @@ nlohmann::ordered_json detail::bench_json(const BenchResult& r) {
                      {"objects_rendered_per_frame", a.objects_rendered_per_frame},
                      {"conditional_objects_per_frame", a.conditional_objects_per_frame},
                      {"conditional_skipped_per_frame", a.conditional_skipped_per_frame},
+                     {"stalled_per_frame", a.stalled_per_frame},
                      {"nodes_visited_per_frame", a.nodes_visited_per_frame},
                      {"extra_objects_per_frame", a.extra_objects_per_frame},
                      {"missed_objects", a.missed_objects},
@@ -259,19 +264,19 @@ void write_csv(const BenchResult& r, std::ostream& out) {
          "failed_multiqueries,query_batches,state_changes,material_changes,render_flushes,"
          "draw_calls,triangles,objects_rendered,nodes_visited,truth_objects,missed_objects,"
          "wrong_pixels,extra_objects,blocking_waits,model_ms,kernel_ms,minor_faults,major_faults,flushes,"
-         "capped,over_cap,result_age,revealed,conditional_objects,conditional_skipped\n";
+         "capped,over_cap,result_age,revealed,conditional_objects,conditional_skipped,stalled\n";
   for (const AlgorithmRun& run : r.runs) {
     for (std::size_t k = 0; k < run.frames.size(); ++k) {
       const FrameStats& f = run.frames[k];
       out << fmt::format("{},{},{},{:.4f},{:.4f},{:.4f},{:.4f},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},"
-                         "{:.4f},{:.4f},{},{},{},{},{},{:.3f},{},{},{}\n",
+                         "{:.4f},{:.4f},{},{},{},{},{},{:.3f},{},{},{},{}\n",
                          run.name, run.repeat, k, f.frame_ms, f.cpu_ms, f.wait_ms, f.gpu_ms, f.queries,
                          f.query_boxes, f.multiqueries, f.failed_multiqueries, f.query_batches,
                          f.state_changes, f.material_changes, f.render_flushes, f.draw_calls,
                          f.triangles, f.objects_rendered, f.nodes_visited, f.truth_objects,
                          f.missed_objects, f.wrong_pixels, f.extra_objects, f.blocking_waits, f.model_ms,
                          f.kernel_ms, f.minor_faults, f.major_faults, f.flushes, f.capped, f.over_cap,
-                         f.result_age, f.revealed, f.conditional_objects, f.conditional_skipped);
+                         f.result_age, f.revealed, f.conditional_objects, f.conditional_skipped, f.stalled);
     }
   }
 }
