@@ -60,7 +60,7 @@ TEST(Cli, HelpOnEveryCommandNamesItsOptions) {
       {"path", {"--scene", "--path", "--out"}},
       {"bench", {"--scene", "--path", "--algo", "--frames", "--fps", "--start", "--size", "--query-mode",
                  "--query-raster", "--query-margin", "--draw", "--verify", "--repeat", "--model", "--json",
-                 "--suite", "--malloc", "--views", "--gl-debug", "--stall-guard"}},
+                 "--suite", "--malloc", "--views", "--gl-debug", "--stall-guard", "--watchdog"}},
       {"calibrate", {"--size", "--repeats", "--out", "--check"}},
       {"sweep", {"--algo", "--vary", "--baseline", "--popping", "--longest", "--scene", "--frames", "--json"}},
       {"render", {"--scene", "--frame", "--fps", "--out", "--gl-debug"}},
@@ -500,6 +500,16 @@ TEST(Cli, StallGuardKeepsConservativeCullersConservativeAndRejectsNegativeTimes)
   EXPECT_EQ(r.code, 0) << r.output;  // 4 would mean a conservative culler missed an object
   EXPECT_NE(r.output.find("verification passed"), std::string::npos) << r.output;
   EXPECT_EQ(run("bench --stall-guard -1 --frames 1").code, 2);
+}
+
+// A frame past the watchdog's time stops the run with exit 1 and names the
+// frame (a microsecond: no GL frame with glFinish is that fast).
+TEST(Cli, AFramePastTheWatchdogsTimeStopsTheRunNamingIt) {
+  const CliRun r = run(std::string("bench ") + kTinyCity + " --algo vfc --frames 2 --warmup 0 --watchdog 0.000001");
+  EXPECT_EQ(r.code, 1) << r.output;
+  EXPECT_NE(r.output.find("occull: watchdog: ground-truth frame 0 of path street has not finished"), std::string::npos)
+      << r.output;
+  EXPECT_EQ(run("bench --watchdog -5 --frames 1").code, 2);
 }
 
 TEST(Cli, TraverseTimesTheGridTraversalAndRejectsBadDimensions) {

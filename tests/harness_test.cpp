@@ -3,6 +3,7 @@
 #include "gl_test_util.hpp"
 #include "occull/error.hpp"
 #include "occull/report.hpp"
+#include "eval/watchdog.hpp"
 #include "test_util.hpp"
 
 #include <gtest/gtest.h>
@@ -14,6 +15,8 @@
 #include <fstream>
 #include <set>
 #include <map>
+#include <mutex>
+#include <condition_variable>
 #include <optional>
 #include <sstream>
 
@@ -390,4 +393,32 @@ TEST(Bench, SplitScreenRunsEachViewOnItsPathAndReportsTheFrameAndEachView) {
   EXPECT_DOUBLE_EQ(r.summaries[0].ratio_to_vfc, 1.0);
   c.views = 9;
   EXPECT_THROW((void)run_bench(c), InputError);
+}
+
+// The harness's watchdog: a step that does not finish is named once its time
+// is up; a step that finishes is never reported. (No timing is asserted: the
+// first waits as long as the watchdog takes, the second uses a time no test
+// machine reaches.)
+TEST(Watchdog, AStepPastItsTimeIsNamedAndAFinishedOneIsNot) {
+  std::mutex mutex;
+  std::condition_variable fired;
+  std::vector<std::string> messages;
+  const auto record = [&](const std::string& m) {
+    const std::lock_guard lock(mutex);
+    messages.push_back(m);
+    fired.notify_all();
+  };
+  {
+    detail::Watchdog patient(1e6, record);
+    { const auto step = patient.step("a quick step"); }
+  }
+  EXPECT_TRUE(messages.empty());
+  detail::Watchdog dog(0.01, record);
+  const auto step = dog.step("ground-truth frame 7 of path street");
+  std::unique_lock lock(mutex);
+  fired.wait(lock, [&] { return !messages.empty(); });
+  ASSERT_EQ(messages.size(), 1u);
+  EXPECT_NE(messages[0].find("ground-truth frame 7 of path street has not finished after"), std::string::npos)
+      << messages[0];
+  EXPECT_NE(messages[0].find("exit 1"), std::string::npos) << messages[0];
 }

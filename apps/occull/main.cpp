@@ -224,6 +224,7 @@ struct BenchArgs {
   int views = 1;
   bool gl_debug = false;
   double stall_guard = 0.0;
+  double watchdog = occull::Session::kWatchdogSeconds;
 };
 
 bool parse_on_off(const std::string& flag, const std::string& s) {
@@ -335,6 +336,7 @@ occull::BenchConfig bench_config(const BenchArgs& a) {
   c.multi_draw = parse_draw_mode(a.draw);
   c.gl_debug = a.gl_debug;
   c.stall_guard_ms = a.stall_guard;
+  c.watchdog_s = a.watchdog;
   c.repeat = a.repeat;
   if (a.bvh_leaf < 1 || a.bvh_leaf > 64)
     throw occull::InputError(fmt::format("--bvh-leaf {}: must be in [1, 64]", a.bvh_leaf));
@@ -549,6 +551,10 @@ void add_run_options(CLI::App* cmd, BenchArgs& a, const std::string& per) {
   cmd->add_option("--stall-guard", a.stall_guard,
                   "milliseconds a culler waits for a query result before taking it as visible, as engines "
                   "guard against a driver that never answers (0: wait; counted as stalled per frame)")
+      ->capture_default_str();
+  cmd->add_option("--watchdog", a.watchdog,
+                  "seconds a frame may take before the run stops with exit 1, naming the frame (a hung GL "
+                  "driver or device; 0: off)")
       ->capture_default_str();
 }
 

@@ -36,6 +36,10 @@
 
 namespace occull {
 
+namespace detail {
+class Watchdog;  // src/eval/watchdog.hpp
+}  // namespace detail
+
 /// Where opaque geometry covers an image: one bit per pixel (row-major,
 /// bottom row first, bit i of word i / 64), how many pixels, and a hash of
 /// the depth image (equal hashes: bit-identical depth).
@@ -189,6 +193,13 @@ class Session {
   /// valid names, or naming what is wrong in the file.
   const CameraPath& path(std::string_view name);
 
+  /// Bounds every frame (a culler's, or one of the ground truth) to this
+  /// many seconds of wall time: past it, the process says which frame hung
+  /// and exits with 1 (a GL call that never returns cannot be unwound).
+  /// 0 turns it off. Default: kWatchdogSeconds.
+  void set_watchdog(double seconds);
+  static constexpr double kWatchdogSeconds = 300.0;
+
   /// Culler frames get the renderer through a StallGuard of this many
   /// milliseconds (0, the default: none, results are waited for).
   /// Precondition: timeout_ms >= 0.
@@ -228,6 +239,7 @@ class Session {
   std::unique_ptr<gl::Renderer> renderer_;
   double stall_guard_ms_ = 0.0;
   std::unique_ptr<StallGuard> guard_;  // over renderer_; goes before it
+  std::unique_ptr<detail::Watchdog> watchdog_;
   std::optional<HardwareProfile> profile_;
   FaultHooks hooks_;
   FrameSampling sampling_;
@@ -260,6 +272,7 @@ struct BenchConfig {
   bool model = false;                     ///< also predict each frame with the NOHC cost model
   bool gl_debug = false;                  ///< GL debug contexts: a failing GL call stops the run (gl::ContextOptions)
   double stall_guard_ms = 0.0;            ///< > 0: results not there within this time count as visible (StallGuard)
+  double watchdog_s = 300.0;              ///< a frame running longer stops the process, exit 1 (Session::set_watchdog; 0: off)
   std::string allocator;                  ///< the process's allocator policy, as the report names it (apply_allocator_policy)
   FaultHooks hooks;                       ///< tests only: break a step on purpose (see FaultHooks)
 };

@@ -1,4 +1,6 @@
 #include "occull/harness.hpp"
+
+#include "watchdog.hpp"
 #include "occull/grid_views.hpp"
 
 #include "occull/error.hpp"
@@ -98,6 +100,11 @@ Session::Session(std::string_view scene_spec, const gl::RendererOptions& rendere
   device_ = context_->info();
   renderer_options_ = renderer_options;
   renderer_ = std::make_unique<gl::Renderer>(bundle_.scene, renderer_options);
+  set_watchdog(kWatchdogSeconds);
+}
+
+void Session::set_watchdog(double seconds) {
+  watchdog_ = std::make_unique<detail::Watchdog>(seconds);
 }
 
 void Session::set_stall_guard(double timeout_ms) {
@@ -143,6 +150,7 @@ View Session::view_at(const CameraPath& path, int k, int frames) const {
 }
 
 FrameStats Session::run_frame(Culler& culler, const View& view, double time_s) {
+  const auto step = watchdog_->step(fmt::format("a culler's frame at {:.3f} s of the path", time_s));
   bundle_.scene.update(time_s);
   const ProcessUsage u0 = process_usage();
   const auto t0 = Clock::now();
@@ -195,6 +203,7 @@ std::vector<FrameTruth> Session::ground_truth(const CameraPath& path, int frames
     bundle_.scene.update(frame_time(path, k, frames));
     const View view = view_at(path, k, frames);
     const detail::FrameLabel where{scene_spec_, path.name(), k};
+    const auto step = watchdog_->step(fmt::format("ground-truth frame {} of path {}", k, path.name()));
     in_frustum.clear();
     for (ObjectId id = 0; id < objects.size(); ++id)
       if (view.frustum.classify(objects[id].bounds) != Containment::outside) in_frustum.push_back(id);
@@ -635,6 +644,9 @@ BenchResult run_bench(const BenchConfig& config, const ProgressFn& progress) {
     throw InputError(fmt::format("stall guard {} ms: must be a number of milliseconds >= 0 (0: off)",
                                  config.stall_guard_ms));
   session.set_stall_guard(config.stall_guard_ms);
+  if (!(config.watchdog_s >= 0.0) || !std::isfinite(config.watchdog_s))
+    throw InputError(fmt::format("watchdog {} s: must be a number of seconds >= 0 (0: off)", config.watchdog_s));
+  session.set_watchdog(config.watchdog_s);
   // The path of each view: those named, else the scene's paths in turn.
   std::vector<const CameraPath*> paths;
   for (int k = 0; k < config.views; ++k) {
