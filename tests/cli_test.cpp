@@ -362,6 +362,16 @@ TEST(Cli, ModelFilesLoadThroughAssimp) {
   EXPECT_EQ(oracle[kTriangles], "12") << "the cube is in view and drawn";
 }
 
+// Found by fuzz_model: an OFF file whose face names vertices it lacks made
+// assimp assert and abort the process (exit 134).
+TEST(Cli, AModelFileWithFacesWithoutVerticesExitsTwoNamingIt) {
+  const std::string off = ::testing::TempDir() + "occull_broken.off";
+  std::ofstream(off) << "OFF\n3 1 0\n0 0 0 1 2\n";
+  const CliRun r = run("bench --scene file:" + off + " --algo vfc --frames 1 --no-report");
+  EXPECT_EQ(r.code, 2) << r.output;
+  EXPECT_NE(r.output.find(off + ": cannot be read as a model"), std::string::npos) << r.output;
+}
+
 // The newcomer's first run: no hardware profile cached, so nohc calibrates
 // in the bench's own process — which once left the ground truth empty and
 // the oracle drawing nothing, with every culler "missing 0".

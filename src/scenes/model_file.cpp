@@ -57,8 +57,13 @@ SceneBundle load_model_file(const std::string& path, std::uint32_t object_triang
   if (!std::filesystem::is_regular_file(path, ec))
     throw InputError(fmt::format("{}: no such file", path));
   Assimp::Importer importer;
-  const aiScene* s = importer.ReadFile(path, aiProcess_Triangulate | aiProcess_GenSmoothNormals |
-                                                 aiProcess_JoinIdenticalVertices | aiProcess_SortByPType);
+  // ValidateDataStructure runs before the other steps and rejects what an
+  // importer made of a malformed file (e.g. faces of an OFF file naming
+  // vertices it lacks), on which assimp's own steps assert and abort the
+  // process (found by fuzz_model).
+  const aiScene* s = importer.ReadFile(path, aiProcess_ValidateDataStructure | aiProcess_Triangulate |
+                                                 aiProcess_GenSmoothNormals | aiProcess_JoinIdenticalVertices |
+                                                 aiProcess_SortByPType);
   if (!s || !s->mRootNode || (s->mFlags & AI_SCENE_FLAGS_INCOMPLETE))
     throw InputError(fmt::format("{}: cannot be read as a model ({})", path, importer.GetErrorString()));
 
