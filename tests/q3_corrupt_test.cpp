@@ -6,6 +6,8 @@
 
 #include <gtest/gtest.h>
 #include <minizip/zip.h>
+#include <fmt/format.h>
+#include <zlib.h>
 
 #include <fstream>
 
@@ -129,4 +131,65 @@ TEST(Q3Corrupt, EveryTruncationIsAnErrorNotACrash) {
     const std::vector<std::byte> cut(full.begin(), full.begin() + long(n));
     EXPECT_NE(error_of(cut), "(no error)") << n;
   }
+}
+
+namespace {
+
+// A .pk3 with one stored (uncompressed) entry maps/NAME.bsp holding `bytes`,
+// whose directory claims `claimed` bytes once inflated.
+std::string pk3_claiming(const std::string& name, const std::vector<std::byte>& bytes, std::uint64_t claimed) {
+  const std::string path = ::testing::TempDir() + "occull_claims_" + name + ".pk3";
+  zipFile z = zipOpen64(path.c_str(), APPEND_STATUS_CREATE);
+  zip_fileinfo info{};
+  const std::string entry = "maps/" + name + ".bsp";
+  zipOpenNewFileInZip2_64(z, entry.c_str(), &info, nullptr, 0, nullptr, 0, nullptr, 0 /* stored */, 0, 1 /* raw */,
+                          claimed > 0xffffffffu);
+  zipWriteInFileInZip(z, bytes.data(), unsigned(bytes.size()));
+  zipCloseFileInZipRaw64(z, claimed, crc32(0, reinterpret_cast<const Bytef*>(bytes.data()), uInt(bytes.size())));
+  zipClose(z, nullptr);
+  return path;
+}
+
+std::string pk3_error(const std::string& path, const std::string& map) {
+  try {
+    (void)q3::read_map_from_pk3(path, map);
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "(no error)";
+}
+
+}  // namespace
+
+TEST(Q3Corrupt, AnEntryClaimingMoreThanTheMapLimitIsRefusedNamingTheLimit) {
+  const auto bytes = test::TinyBsp::example().bytes();
+  const std::string path = pk3_claiming("huge", bytes, std::uint64_t(3) << 30);
+  const std::string e = pk3_error(path, "huge");
+  EXPECT_NE(e.find("claims 3221225472 bytes, past the limit of 268435456 bytes for a map (occull::limits::map_bytes)"),
+            std::string::npos) << e;
+  EXPECT_NE(e.find(path), std::string::npos) << e;
+}
+
+TEST(Q3Corrupt, AnEntryInflatingToLessThanItClaimsIsDamaged) {
+  const auto bytes = test::TinyBsp::example().bytes();
+  const std::string path = pk3_claiming("short", bytes, 100u << 20);
+  const std::string e = pk3_error(path, "short");
+  EXPECT_NE(e.find(fmt::format("maps/short.bsp is damaged (inflates to {} bytes, its directory says 104857600)",
+                               bytes.size())),
+            std::string::npos) << e;
+}
+
+TEST(Q3Corrupt, AnEntryInflatingToMoreThanItClaimsIsDamaged) {
+  const auto bytes = test::TinyBsp::example().bytes();
+  const std::string path = pk3_claiming("long", bytes, 16);
+  const std::string e = pk3_error(path, "long");
+  EXPECT_NE(e.find("maps/long.bsp is damaged (inflates to"), std::string::npos) << e;
+  EXPECT_NE(e.find("its directory says 16)"), std::string::npos) << e;
+}
+
+TEST(Q3Corrupt, TheFuzzedArchiveClaimingGigabytesIsRefusedWithoutAllocatingThem) {
+  // Found by fuzz_pk3 (an out-of-memory): 151 bytes claiming ~2 GB inflated.
+  const std::string path = std::string(OCCULL_SOURCE_DIR) + "/tests/corpus/pk3/claims-2gb.pk3";
+  const std::string e = pk3_error(path, "a");
+  EXPECT_NE(e.find("past the limit of 268435456 bytes for a map"), std::string::npos) << e;
 }

@@ -7,6 +7,7 @@
 #pragma once
 
 #include "occull/geometry.hpp"
+#include "occull/input_limits.hpp"
 
 #include <cstdint>
 #include <span>
@@ -70,17 +71,26 @@ struct Object {
   [[nodiscard]] bool dynamic() const noexcept { return motion >= 0; }
 };
 
+/// The most a Scene holds; past it add_object / add_mesh throw InputError.
+/// The defaults are the documented caps of occull/input_limits.hpp.
+struct SceneLimits {
+  std::size_t objects = limits::objects;
+  std::uint64_t mesh_triangles = limits::mesh_triangles;  ///< each mesh counted once
+};
+
 /// A scene: the meshes, materials, objects and motions of one world.
 /// Invariant: every object's `bounds` and `triangles` match its mesh and
 /// transform (add_object and update maintain it).
 class Scene {
  public:
-  explicit Scene(std::string name = {}) : name_(std::move(name)) {}
+  explicit Scene(std::string name = {}, const SceneLimits& caps = {}) : name_(std::move(name)), caps_(caps) {}
 
   /// Adds a mesh. Precondition: indices in range, normals.size() == positions.size().
+  /// Throws InputError past SceneLimits::mesh_triangles triangles in all meshes.
   MeshId add_mesh(Mesh mesh);
   MaterialId add_material(Material material);
   /// Adds a static object. Preconditions: mesh and material exist.
+  /// Throws InputError past SceneLimits::objects objects.
   ObjectId add_object(MeshId mesh, MaterialId material, const glm::mat4& transform,
                       OccluderClass occluder);
   /// Adds a dynamic object that follows `motion` (its transform at time 0 is
@@ -112,6 +122,7 @@ class Scene {
 
  private:
   std::string name_;
+  SceneLimits caps_;
   std::vector<Mesh> meshes_;
   std::vector<Material> materials_;
   std::vector<Object> objects_;
@@ -120,6 +131,7 @@ class Scene {
   std::vector<ObjectId> dynamic_;
   std::vector<Aabb> mesh_bounds_;
   std::vector<double> mesh_area_;
+  std::uint64_t mesh_triangles_ = 0;  // sum over meshes_, against caps_
 };
 
 }  // namespace occull

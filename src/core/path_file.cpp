@@ -1,4 +1,5 @@
 #include "occull/error.hpp"
+#include "occull/input_limits.hpp"
 #include "occull/view.hpp"
 
 #include <fmt/format.h>
@@ -11,8 +12,7 @@
 namespace occull {
 
 CameraPath read_path_file(const std::string& file) {
-  std::ifstream in(file);
-  if (!in) throw InputError(fmt::format("{}: cannot be opened", file));
+  std::istringstream in(limits::read_file(file, limits::text_file_bytes, "a path file (occull::limits::text_file_bytes)"));
   std::vector<CameraPath::Key> keys;
   std::string line;
   for (int number = 1; std::getline(in, line); ++number) {

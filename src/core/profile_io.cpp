@@ -1,6 +1,7 @@
 #include "occull/profile_io.hpp"
 
 #include "occull/error.hpp"
+#include "occull/input_limits.hpp"
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
@@ -117,11 +118,8 @@ std::string default_profile_path(std::string_view renderer) {
 std::optional<HardwareProfile> load_profile(const std::string& path) {
   std::error_code ec;
   if (!std::filesystem::exists(path, ec)) return std::nullopt;
-  std::ifstream f(path, std::ios::binary);
-  if (!f) throw InputError(fmt::format("{}: cannot be read", path));
-  std::ostringstream text;
-  text << f.rdbuf();
-  return profile_from_json(text.str(), path);
+  return profile_from_json(
+      limits::read_file(path, limits::text_file_bytes, "a hardware profile (occull::limits::text_file_bytes)"), path);
 }
 
 void save_profile(const HardwareProfile& profile, const std::string& path) {

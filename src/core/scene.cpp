@@ -1,5 +1,10 @@
 #include "occull/scene.hpp"
 
+#include "occull/error.hpp"
+#include "occull/input_limits.hpp"
+
+#include <fmt/format.h>
+
 #include <glm/gtc/matrix_transform.hpp>
 
 #include <cassert>
@@ -50,6 +55,11 @@ glm::mat4 Motion::transform_at(double time_s) const {
 
 MeshId Scene::add_mesh(Mesh mesh) {
   assert(mesh.normals.size() == mesh.positions.size());
+  if (mesh_triangles_ + mesh.triangle_count() > caps_.mesh_triangles)
+    throw InputError(fmt::format("scene {}: {} triangles in its meshes is past the limit of {} "
+                                 "(occull::limits::mesh_triangles)",
+                                 name_, mesh_triangles_ + mesh.triangle_count(), caps_.mesh_triangles));
+  mesh_triangles_ += mesh.triangle_count();
   mesh_bounds_.push_back(mesh.bounds());
   mesh_area_.push_back(mesh.surface_area());
   meshes_.push_back(std::move(mesh));
@@ -64,6 +74,9 @@ MaterialId Scene::add_material(Material material) {
 ObjectId Scene::add_object(MeshId mesh, MaterialId material, const glm::mat4& transform,
                            OccluderClass occluder) {
   assert(mesh < meshes_.size() && material < materials_.size());
+  if (objects_.size() >= caps_.objects)
+    throw InputError(fmt::format("scene {}: more than {} objects, the limit (occull::limits::objects)", name_,
+                                 caps_.objects));
   Object o;
   o.mesh = mesh;
   o.material = material;

@@ -3,6 +3,7 @@
 
 #include "cullers.hpp"
 #include "occull/error.hpp"
+#include "occull/input_limits.hpp"
 
 #include <cctype>
 #include <charconv>
@@ -236,6 +237,10 @@ const AlgorithmInfo& find_algorithm(std::string_view name) {
 }
 
 AlgorithmSpec parse_algorithm_spec(std::string_view spec, const Options& base) {
+  if (spec.size() > limits::spec_chars)
+    throw InputError(fmt::format("algorithm spec '{}...': {} characters is past the limit of {} "
+                                 "(occull::limits::spec_chars)",
+                                 spec.substr(0, 32), spec.size(), limits::spec_chars));
   const auto colon = spec.find(':');
   AlgorithmSpec out{std::string(spec.substr(0, colon)), base};
   const AlgorithmInfo& info = find_algorithm(out.name);

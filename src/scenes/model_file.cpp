@@ -4,6 +4,7 @@
 #include "model_file.hpp"
 
 #include "occull/error.hpp"
+#include "occull/input_limits.hpp"
 #include "triangle_soup.hpp"
 
 #include <assimp/Importer.hpp>
@@ -56,6 +57,7 @@ SceneBundle load_model_file(const std::string& path, std::uint32_t object_triang
   std::error_code ec;
   if (!std::filesystem::is_regular_file(path, ec))
     throw InputError(fmt::format("{}: no such file", path));
+  limits::check_file_size(path, limits::model_bytes, "a model (occull::limits::model_bytes)");
   Assimp::Importer importer;
   // ValidateDataStructure runs before the other steps and rejects what an
   // importer made of a malformed file (e.g. faces of an OFF file naming

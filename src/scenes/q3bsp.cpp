@@ -4,6 +4,7 @@
 #include "occull/q3bsp.hpp"
 
 #include "occull/error.hpp"
+#include "occull/input_limits.hpp"
 
 #include <fmt/format.h>
 #include <minizip/unzip.h>
@@ -286,6 +287,7 @@ Zip open_zip(const std::string& pk3) {
     std::ifstream f(pk3, std::ios::binary);
     if (!f) throw InputError(fmt::format("{}: cannot be opened", pk3));
   }
+  limits::check_file_size(pk3, limits::archive_bytes, "a .pk3 archive (occull::limits::archive_bytes)");
   Zip z(unzOpen64(pk3.c_str()));
   if (!z) throw InputError(fmt::format("{}: not a zip archive (a .pk3 is a zip of game files)", pk3));
   return z;
@@ -326,14 +328,27 @@ std::vector<std::byte> read_map_from_pk3(const std::string& pk3, std::string_vie
   unz_file_info64 info;
   if (unzGetCurrentFileInfo64(z.get(), &info, nullptr, 0, nullptr, 0, nullptr, 0) != UNZ_OK)
     throw InputError(fmt::format("{}: damaged entry {}", pk3, entry));
-  if (info.uncompressed_size > (std::uint64_t(1) << 31))
-    throw InputError(fmt::format("{}: {} claims {} bytes, too large for a map", pk3, entry, info.uncompressed_size));
-  std::vector<std::byte> bytes(std::size_t(info.uncompressed_size));
+  const std::uint64_t claimed = info.uncompressed_size;
+  if (claimed > limits::map_bytes)
+    throw InputError(fmt::format("{}: {} claims {} bytes, past the limit of {} bytes for a map "
+                                 "(occull::limits::map_bytes)",
+                                 pk3, entry, claimed, limits::map_bytes));
   if (unzOpenCurrentFile(z.get()) != UNZ_OK) throw InputError(fmt::format("{}: cannot open {}", pk3, entry));
-  const int read = unzReadCurrentFile(z.get(), bytes.data(), unsigned(bytes.size()));
+  // The buffer grows with what inflates, not with the size the directory
+  // claims: a few bytes of zip may claim gigabytes (found by fuzz_pk3).
+  std::vector<std::byte> bytes;
+  constexpr std::size_t kPiece = std::size_t(1) << 20;
+  int read = 0;
+  do {
+    const std::size_t at = bytes.size();
+    bytes.resize(at + kPiece);
+    read = unzReadCurrentFile(z.get(), bytes.data() + at, unsigned(kPiece));
+    bytes.resize(at + std::size_t(std::max(read, 0)));
+  } while (read > 0 && bytes.size() <= claimed);
   const int close = unzCloseCurrentFile(z.get());
-  if (read < 0 || std::size_t(read) != bytes.size() || close != UNZ_OK)
-    throw InputError(fmt::format("{}: {} is damaged (read {} of {} bytes)", pk3, entry, read, bytes.size()));
+  if (read < 0 || bytes.size() != claimed || close != UNZ_OK)
+    throw InputError(fmt::format("{}: {} is damaged (inflates to {}{} bytes, its directory says {})", pk3, entry,
+                                 bytes.size(), read > 0 ? " or more" : "", claimed));
   return bytes;
 }
 

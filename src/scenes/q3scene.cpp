@@ -2,6 +2,7 @@
 // grouped into culling-sized objects, flat colours per texture, and the
 // `tour` camera path through the spawn points.
 #include "occull/error.hpp"
+#include "occull/input_limits.hpp"
 #include "occull/q3bsp.hpp"
 #include "triangle_soup.hpp"
 
@@ -37,6 +38,19 @@ glm::vec3 texture_color(const std::string& name) {
   const glm::vec3 k = glm::clamp(glm::abs(glm::fract(glm::vec3(hue) + glm::vec3(1.0f, 2.0f / 3, 1.0f / 3)) * 6.0f - 3.0f) - 1.0f,
                                  0.0f, 1.0f);
   return val * glm::mix(glm::vec3(1.0f), k, sat);
+}
+
+// Most triangles triangles_of can make: polygons' and meshes' own, and each
+// patch's 3x3 pieces tessellated to `patch_level` (two per grid square).
+std::uint64_t triangle_bound(const Map& map, int patch_level) {
+  std::uint64_t n = 0;
+  for (const Face& f : map.faces) {
+    if (f.type == FaceType::polygon || f.type == FaceType::mesh) n += std::uint64_t(f.meshvert_count / 3);
+    if (f.type == FaceType::patch)
+      n += std::uint64_t((f.patch_width - 1) / 2) * std::uint64_t((f.patch_height - 1) / 2) * 2u *
+           std::uint64_t(patch_level) * std::uint64_t(patch_level);
+  }
+  return n;
 }
 
 // Triangles of every drawn face, in occull coordinates, wound counter-
@@ -180,7 +194,14 @@ SceneBundle build_scene(const Map& map, std::string name, const LoadOptions& opt
                         std::vector<std::vector<std::int32_t>>* object_faces) {
   SceneBundle bundle{Scene(std::move(name)), {}, Lens{75.0f, 0.05f, 400.0f}};
   Scene& scene = bundle.scene;
-  std::vector<Triangle> tris = triangles_of(map, std::clamp(options.patch_level, 1, 32));
+  const int patch_level = std::clamp(options.patch_level, 1, 32);
+  // Checked before tessellating: a map of big patches at a fine level would
+  // otherwise allocate its triangles before the scene's cap sees them.
+  if (const std::uint64_t n = triangle_bound(map, patch_level); n > limits::mesh_triangles)
+    throw InputError(fmt::format("{}: its faces tessellate to {} triangles at patch level {}, past the limit of {} "
+                                 "(occull::limits::mesh_triangles)",
+                                 scene.name(), n, patch_level, limits::mesh_triangles));
+  std::vector<Triangle> tris = triangles_of(map, patch_level);
 
   // Materials per texture.
   std::vector<MaterialId> material(map.textures.size());
@@ -243,9 +264,7 @@ SceneBundle load(std::string_view spec, const LoadOptions& options) {
     bytes = read_map_from_pk3(pk3, name);
     source = fmt::format("{}:maps/{}.bsp", pk3, name);
   } else if (lowered.size() > 4 && lowered.substr(lowered.size() - 4) == ".bsp") {
-    std::ifstream f(s, std::ios::binary);
-    if (!f) throw InputError(fmt::format("{}: cannot be opened", s));
-    std::vector<char> chars((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
+    const std::string chars = limits::read_file(s, limits::map_bytes, "a map (occull::limits::map_bytes)");
     bytes.resize(chars.size());
     std::memcpy(bytes.data(), chars.data(), chars.size());
     source = s;

@@ -1,5 +1,6 @@
 // Registry of the embedded scenes and parsing of scene specs.
 #include "occull/error.hpp"
+#include "occull/input_limits.hpp"
 #include "model_file.hpp"
 #include "occull/q3bsp.hpp"
 #include "scenes_internal.hpp"
@@ -122,6 +123,10 @@ ParsedSpec parse_spec(std::string_view spec) {
 }  // namespace scenes
 
 SceneBundle make_scene(std::string_view spec) {
+  if (spec.size() > limits::spec_chars)
+    throw InputError(fmt::format("scene spec '{}...': {} characters is past the limit of {} "
+                                 "(occull::limits::spec_chars)",
+                                 spec.substr(0, 32), spec.size(), limits::spec_chars));
   if (spec.rfind("q3:", 0) == 0) return q3::load(spec.substr(3));
   if (spec.rfind("file:", 0) == 0) return scenes::load_model_file(std::string(spec.substr(5)));
   const scenes::ParsedSpec parsed = scenes::parse_spec(spec);

@@ -1,0 +1,106 @@
+// The caps on input (occull/input_limits.hpp): a file, string or scene past
+// one is an InputError naming it, its size and the limit, before anything
+// that size is allocated.
+#include "occull/culler.hpp"
+#include "occull/error.hpp"
+#include "occull/input_limits.hpp"
+#include "occull/q3bsp.hpp"
+#include "occull/scene.hpp"
+#include "occull/scenes.hpp"
+#include "occull/view.hpp"
+#include "test_util.hpp"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+
+using namespace occull;
+
+namespace {
+
+template <class F>
+std::string error_of(F&& f) {
+  try {
+    f();
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "(no error)";
+}
+
+std::string file_of(const std::string& name, std::size_t bytes) {
+  const std::string path = ::testing::TempDir() + name;
+  std::ofstream(path, std::ios::binary) << std::string(bytes, '#');
+  return path;
+}
+
+}  // namespace
+
+TEST(InputLimits, AFileLargerThanItsLimitIsRefusedNamingTheFileItsSizeAndTheLimit) {
+  const std::string path = file_of("occull_limits_big.txt", 1000);
+  const std::string e = error_of([&] { (void)limits::read_file(path, 999, "a test file"); });
+  EXPECT_EQ(e, path + ": 1000 bytes is past the limit of 999 bytes for a test file");
+  EXPECT_EQ(limits::read_file(path, 1000, "a test file").size(), 1000u);
+}
+
+TEST(InputLimits, AFolderOrAMissingFileIsAnErrorNamingIt) {
+  const std::string dir = ::testing::TempDir();
+  EXPECT_NE(error_of([&] { (void)limits::read_file(dir, 10, "x"); }).find("is a folder"), std::string::npos);
+  EXPECT_NE(error_of([&] { (void)limits::read_file(dir + "/no-such-file", 10, "x"); }).find("cannot be opened"),
+            std::string::npos);
+}
+
+TEST(InputLimits, APathFilePastTheTextLimitIsRefusedBeforeItIsParsed) {
+  const std::string path = file_of("occull_limits_big.path", limits::text_file_bytes + 1);
+  const std::string e = error_of([&] { (void)read_path_file(path); });
+  EXPECT_NE(e.find("past the limit of 16777216 bytes for a path file (occull::limits::text_file_bytes)"),
+            std::string::npos) << e;
+  std::filesystem::remove(path);
+}
+
+TEST(InputLimits, SpecsLongerThanTheLimitAreRefusedShowingTheirStart) {
+  const std::string scene = "city:" + std::string(limits::spec_chars, 'x');
+  const std::string e = error_of([&] { (void)make_scene(scene); });
+  EXPECT_NE(e.find("scene spec 'city:xxx"), std::string::npos) << e;
+  EXPECT_NE(e.find("4101 characters is past the limit of 4096 (occull::limits::spec_chars)"), std::string::npos) << e;
+  const std::string algo = "chcpp:" + std::string(limits::spec_chars, 'x');
+  EXPECT_NE(error_of([&] { (void)parse_algorithm_spec(algo); }).find("is past the limit of 4096"), std::string::npos);
+}
+
+TEST(InputLimits, ASceneRefusesObjectsPastItsLimit) {
+  Scene s("capped", SceneLimits{2, 100});
+  const MaterialId m = s.add_material({});
+  const MeshId mesh = s.add_mesh(test::box_mesh({{0, 0, 0}, {1, 1, 1}}));
+  s.add_object(mesh, m, glm::mat4(1.0f), OccluderClass::always);
+  s.add_object(mesh, m, glm::mat4(1.0f), OccluderClass::always);
+  const std::string e = error_of([&] { s.add_object(mesh, m, glm::mat4(1.0f), OccluderClass::always); });
+  EXPECT_EQ(e, "scene capped: more than 2 objects, the limit (occull::limits::objects)");
+  EXPECT_EQ(s.objects().size(), 2u);
+}
+
+TEST(InputLimits, ASceneRefusesMeshTrianglesPastItsLimitCountingEachMeshOnce) {
+  Scene s("capped", SceneLimits{100, 20});
+  (void)s.add_mesh(test::box_mesh({{0, 0, 0}, {1, 1, 1}}));  // 12 triangles
+  const std::string e = error_of([&] { (void)s.add_mesh(test::box_mesh({{0, 0, 0}, {1, 1, 1}})); });
+  EXPECT_EQ(e, "scene capped: 24 triangles in its meshes is past the limit of 20 (occull::limits::mesh_triangles)");
+  EXPECT_EQ(s.meshes().size(), 1u);
+}
+
+TEST(InputLimits, AMapWhosePatchesTessellatePastTheTriangleLimitIsRefusedBeforeTessellating) {
+  // 32769 faces sharing one 3x3 patch: 2 x 32^2 triangles each at level 32,
+  // 2^26 + 2048 in all, from a few kilobytes of map.
+  q3::Map map;
+  map.textures.push_back({"textures/test", 0, 1});
+  for (int i = 0; i < 9; ++i) map.vertices.push_back({glm::vec3(float(i % 3), float(i / 3), 0.0f), glm::vec3(0, 0, 1)});
+  q3::Face patch;
+  patch.type = q3::FaceType::patch;
+  patch.vertex_count = 9;
+  patch.patch_width = patch.patch_height = 3;
+  map.faces.assign((std::size_t(1) << 15) + 1, patch);
+  const std::string e = error_of([&] { (void)q3::build_scene(map, "q3:patches", {32, 500}); });
+  EXPECT_EQ(e, "q3:patches: its faces tessellate to 67110912 triangles at patch level 32, past the limit of "
+               "67108864 (occull::limits::mesh_triangles)");
+  map.faces.resize(4);
+  EXPECT_EQ(q3::build_scene(map, "q3:patches", {32, 500}).scene.triangle_count(), 4u * 2048u);
+}
