@@ -53,7 +53,7 @@ enum Column { kMean = 1, kMedian, kP95, kMax, kVsVfc, kVsOracle, kQueries, kStat
 
 TEST(Cli, HelpOnEveryCommandNamesItsOptions) {
   const std::vector<std::pair<std::string, std::vector<std::string>>> commands = {
-      {"", {"bench", "sweep", "calibrate", "render", "scenes", "algos", "info", "path", "traverse", "Exit codes"}},
+      {"", {"bench", "sweep", "calibrate", "render", "scenes", "algos", "info", "path", "traverse", "soak", "Exit codes"}},
       {"info", {"--help"}},
       {"scenes", {"--list-maps"}},
       {"algos", {"--help"}},
@@ -64,7 +64,9 @@ TEST(Cli, HelpOnEveryCommandNamesItsOptions) {
       {"calibrate", {"--size", "--repeats", "--out", "--check"}},
       {"sweep", {"--algo", "--vary", "--baseline", "--popping", "--longest", "--scene", "--frames", "--json"}},
       {"render", {"--scene", "--frame", "--fps", "--out", "--gl-debug"}},
-      {"traverse", {"--dims", "--views", "--mode", "--fov", "--seed"}}};
+      {"traverse", {"--dims", "--views", "--mode", "--fov", "--seed"}},
+      {"soak", {"--scene", "--path", "--algo", "--frames", "--window", "--warmup", "--fps", "--size", "--json",
+                "--gl-debug", "--stall-guard", "--watchdog"}}};
   for (const auto& [cmd, options] : commands) {
     const CliRun r = run(cmd + " --help");
     EXPECT_EQ(r.code, 0) << cmd << ": " << r.output;
@@ -544,4 +546,17 @@ TEST(Cli, SplitScreenBenchNamesBothPathsAndAPathListNeedsViews) {
   const CliRun list = run("bench --path street,turn --frames 1");
   EXPECT_EQ(list.code, 2) << list.output;
   EXPECT_NE(list.output.find("needs --views"), std::string::npos) << list.output;
+}
+
+TEST(Cli, SoakPrintsAWindowRowPerAlgorithmAndAVerdictAndRejectsAPartialWindow) {
+  const std::string json = ::testing::TempDir() + "occull_soak.json";
+  const CliRun r = run(std::string("soak ") + kTinyCity + " --algo chcpp --frames 20 --window 10 --warmup 2 --json " + json);
+  EXPECT_TRUE(r.code == 0 || r.code == 5) << r.output;  // 5: memory or the pool grew (exit code documented)
+  EXPECT_NE(r.output.find("chcpp: memory"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("verdict: "), std::string::npos) << r.output;
+  std::ifstream in(json);
+  EXPECT_EQ(nlohmann::json::parse(in)["flat"].get<bool>(), r.code == 0);
+  const CliRun bad = run(std::string("soak ") + kTinyCity + " --frames 25 --window 10");
+  EXPECT_EQ(bad.code, 2);
+  EXPECT_NE(bad.output.find("must be a positive multiple of the window"), std::string::npos) << bad.output;
 }

@@ -5,7 +5,8 @@
 // run-time invariant of the instrument); 2 bad input (unknown name, invalid
 // number, bad option, corrupt file); 3 no usable OpenGL 4.5 (EGL or driver
 // missing); 4 bench: a conservative algorithm missed a visible object (the
-// table and report are written first).
+// table and report are written first); 5 soak: memory or the query pool
+// grew (the table and JSON are written first).
 #include "occull/culler.hpp"
 #include "occull/error.hpp"
 #include "occull/grid.hpp"
@@ -18,6 +19,7 @@
 #include "occull/harness.hpp"
 #include "occull/report.hpp"
 #include "occull/scenes.hpp"
+#include "occull/soak.hpp"
 #include "occull/suite.hpp"
 #include "occull/sweep.hpp"
 
@@ -40,6 +42,7 @@ constexpr int kExitInternal = 1;
 constexpr int kExitInput = 2;
 constexpr int kExitNoGl = 3;
 constexpr int kExitVerificationFailed = 4;
+constexpr int kExitSoakGrew = 5;
 
 constexpr const char* kMallocHelp =
     "allocator policy of the process: engine (keep freed heap memory, as engines do, so driver batches do "
@@ -558,6 +561,65 @@ void add_run_options(CLI::App* cmd, BenchArgs& a, const std::string& per) {
       ->capture_default_str();
 }
 
+struct SoakArgs {
+  std::string scene = "city";
+  std::string path;
+  std::string algos = "chcpp,nohc,grid";
+  std::int64_t frames = 100000;
+  std::int64_t window = 10000;
+  std::int64_t warmup = 1000;
+  double fps = 30.0;
+  std::string size = "320x180";
+  std::vector<std::string> opts;
+  std::string json;
+  std::string malloc_policy = "engine";
+  bool gl_debug = false;
+  double stall_guard = 0.0;
+  double watchdog = occull::Session::kWatchdogSeconds;
+};
+
+// A looped walk per culler for many frames: what must stay flat (memory,
+// the query pool, buffers) and how the frame time drifts, per window.
+int cmd_soak(const SoakArgs& a) {
+  occull::SoakConfig c;
+  const std::string allocator = occull::apply_allocator_policy(occull::parse_allocator_policy(a.malloc_policy));
+  c.scene = a.scene;
+  c.path = a.path;
+  c.algorithms = split_list(a.algos);
+  c.frames = a.frames;
+  c.window = a.window;
+  c.warmup = a.warmup;
+  c.fps = a.fps;
+  const Size size = parse_size(a.size);
+  c.renderer.width = size.width;
+  c.renderer.height = size.height;
+  c.context.debug = a.gl_debug;
+  c.options = parse_options(a.opts);
+  if (!(a.stall_guard >= 0.0)) throw occull::InputError("--stall-guard must be >= 0 milliseconds");
+  if (!(a.watchdog >= 0.0)) throw occull::InputError("--watchdog must be >= 0 seconds");
+  c.stall_guard_ms = a.stall_guard;
+  c.watchdog_s = a.watchdog;
+  const auto json = open_output(a.json);
+  const bool tty = isatty(fileno(stderr)) != 0;
+  const auto start = std::chrono::steady_clock::now();
+  const occull::SoakResult result = occull::run_soak(c, [&](const std::string& algo, std::int64_t k, std::int64_t n) {
+    if (!tty && k % 5000 != 1 && k != n) return;
+    const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    std::fprintf(stderr, "%s[%s] frame %lld/%lld, %.0f s%s", tty ? "\r" : "", algo.c_str(), (long long)k,
+                 (long long)n, s, tty && k != n ? "   " : "\n");
+    std::fflush(stderr);
+  });
+  std::cout << "allocator: " << allocator << "\n";
+  occull::print_soak(result, std::cout);
+  std::cout.flush();
+  if (json) {
+    occull::write_soak_json(result, *json);
+    json->flush();
+    check_written(*json, a.json);
+  }
+  return occull::soak_flat(result) ? 0 : kExitSoakGrew;
+}
+
 struct TraverseArgs {
   std::string dims = "1000x10x1000";
   int views = 200;
@@ -623,7 +685,7 @@ int main(int argc, char** argv) {
   CLI::App app{"occull — occlusion culling with hardware occlusion queries, and the instrument "
                "that measures it.\n\nExit codes: 0 success, 1 internal error (or a violated invariant of the "
                "instrument), 2 bad input, 3 no usable OpenGL 4.5, 4 a conservative algorithm missed a "
-               "visible object (bench)."};
+               "visible object (bench), 5 memory or the query pool grew (soak)."};
   app.require_subcommand(1);
 
   app.add_subcommand("info", "GL vendor, renderer, version, query counter bits, culling extensions");
@@ -717,6 +779,30 @@ int main(int argc, char** argv) {
   r->add_option("--opt", render.opts, "algorithm option algo.key=value (repeatable)");
   r->add_flag("--gl-debug", render.gl_debug, kGlDebugHelp);
 
+  SoakArgs soak;
+  auto* so = app.add_subcommand("soak",
+                                "loop a walk for many frames per culler and report memory, GL objects and frame "
+                                "time per window (exit 5 when memory or the query pool grew)");
+  so->add_option("--scene", soak.scene, "scene spec name[:key=value,...]; its dynamic objects move all along")
+      ->capture_default_str();
+  so->add_option("--path", soak.path, "camera path, looped (default: turn where the scene has it, else its first)");
+  so->add_option("--algo", soak.algos, "comma-separated algorithms, run one after another")->capture_default_str();
+  so->add_option("--frames", soak.frames, "measured frames per algorithm (a multiple of --window)")
+      ->capture_default_str();
+  so->add_option("--window", soak.window, "frames per reported row")->capture_default_str();
+  so->add_option("--warmup", soak.warmup, "frames before the first window")->capture_default_str();
+  so->add_option("--fps", soak.fps, "frames per second of path time (the path loops)")->capture_default_str();
+  so->add_option("--size", soak.size, "render size WIDTHxHEIGHT")->capture_default_str();
+  so->add_option("--opt", soak.opts, "algorithm option algo.key=value (repeatable)");
+  so->add_option("--json", soak.json, "write the windows as JSON to this file");
+  so->add_option("--malloc", soak.malloc_policy, kMallocHelp)->capture_default_str();
+  so->add_flag("--gl-debug", soak.gl_debug, kGlDebugHelp);
+  so->add_option("--stall-guard", soak.stall_guard,
+                 "milliseconds a culler waits for a query result before taking it as visible (0: wait)")
+      ->capture_default_str();
+  so->add_option("--watchdog", soak.watchdog, "seconds a frame may take before the run stops with exit 1 (0: off)")
+      ->capture_default_str();
+
   TraverseArgs traverse;
   auto* tv = app.add_subcommand("traverse",
                                 "time the grid's occlusion-order traversal on one core over random views "
@@ -760,6 +846,7 @@ int main(int argc, char** argv) {
     if (cmd == "render") return cmd_render(render);
     if (cmd == "calibrate") return cmd_calibrate(calibrate);
     if (cmd == "traverse") return cmd_traverse(traverse);
+    if (cmd == "soak") return cmd_soak(soak);
   } catch (const occull::InputError& e) {
     std::cerr << "occull: " << e.what() << "\n";
     return kExitInput;

@@ -28,6 +28,15 @@ struct ProcessUsage {
 /// The process's usage now. Never fails (zeros where the OS says nothing).
 [[nodiscard]] ProcessUsage process_usage() noexcept;
 
+/// The process's memory now.
+struct MemoryUsage {
+  std::uint64_t resident_bytes = 0;  ///< resident set (/proc/self/statm), bytes; 0 where unknown
+  std::uint64_t heap_bytes = 0;      ///< bytes malloc has handed out and not had back (glibc mallinfo2); 0 where unknown
+};
+
+/// Never fails (zeros where the OS or C library says nothing).
+[[nodiscard]] MemoryUsage memory_usage() noexcept;
+
 /// How the process's heap allocator returns memory to the OS.
 enum class AllocatorPolicy {
   /// Keep freed memory for reuse, as engines do: glibc trims the heap only

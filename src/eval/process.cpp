@@ -4,7 +4,10 @@
 
 #include <fmt/format.h>
 
+#include <cstdio>
+
 #include <sys/resource.h>
+#include <unistd.h>
 
 #if defined(__GLIBC__)
 #include <malloc.h>
@@ -21,6 +24,21 @@ ProcessUsage process_usage() noexcept {
   rusage u{};
   if (getrusage(RUSAGE_SELF, &u) != 0) return {};
   return {std::uint64_t(u.ru_minflt), std::uint64_t(u.ru_majflt), to_ms(u.ru_stime), to_ms(u.ru_utime)};
+}
+
+MemoryUsage memory_usage() noexcept {
+  MemoryUsage m;
+  if (std::FILE* f = std::fopen("/proc/self/statm", "r")) {
+    unsigned long long size = 0, resident = 0;
+    if (std::fscanf(f, "%llu %llu", &size, &resident) == 2)
+      m.resident_bytes = std::uint64_t(resident) * std::uint64_t(sysconf(_SC_PAGESIZE));
+    std::fclose(f);
+  }
+#if defined(__GLIBC__) && (__GLIBC__ > 2 || __GLIBC_MINOR__ >= 33)
+  const struct mallinfo2 mi = mallinfo2();
+  m.heap_bytes = std::uint64_t(mi.uordblks) + std::uint64_t(mi.hblkhd);
+#endif
+  return m;
 }
 
 AllocatorPolicy parse_allocator_policy(std::string_view name) {

@@ -7,6 +7,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <array>
 #include <cassert>
 #include <chrono>
 #include <stdexcept>
@@ -291,6 +292,11 @@ struct Renderer::Impl {
   }
   std::vector<QueryId> free_queries;
   std::size_t in_flight = 0;
+  // Every buffer object the renderer owns.
+  [[nodiscard]] std::array<GLuint, 7> buffer_names() const {
+    return {vertex_buffer, index_buffer, object_index_buffer, object_buffer, cube_vertices, box_buffer,
+            indirect_buffer};
+  }
   GLsizeiptr box_offset = 0;  // next free box in the stream buffer
 
   enum class Mode { none, render, query } mode = Mode::none;
@@ -690,10 +696,8 @@ Renderer::~Renderer() {
     glDeleteQueries(GLsizei(g.query_names.size()), g.query_names.data());
   if (g.timer) glDeleteQueries(1, &g.timer);
   glDeleteQueries(1, &g.truth_query);
-  const GLuint buffers[] = {g.vertex_buffer, g.index_buffer,  g.object_index_buffer,
-                            g.object_buffer, g.cube_vertices,
-                            g.box_buffer,    g.indirect_buffer};
-  glDeleteBuffers(GLsizei(std::size(buffers)), buffers);
+  const auto buffers = g.buffer_names();
+  glDeleteBuffers(GLsizei(buffers.size()), buffers.data());
   const GLuint vaos[] = {g.scene_vao, g.query_vao};
   glDeleteVertexArrays(2, vaos);
   glDeleteProgram(g.scene_program);
@@ -1031,6 +1035,20 @@ std::vector<Renderer::ObjectPixels> Renderer::visible_pixels(const View& view,
 }
 
 std::size_t Renderer::queries_in_flight() const noexcept { return impl_->in_flight; }
+
+Renderer::Resources Renderer::resources() const {
+  const Impl& g = *impl_;
+  Resources r;
+  r.queries = g.query_names.size();
+  r.queries_free = g.free_queries.size();
+  for (const GLuint b : g.buffer_names()) {
+    GLint64 size = 0;
+    glGetNamedBufferParameteri64v(b, GL_BUFFER_SIZE, &size);
+    r.buffer_bytes += size;
+    ++r.buffers;
+  }
+  return r;
+}
 int Renderer::width() const noexcept { return impl_->options.width; }
 int Renderer::height() const noexcept { return impl_->options.height; }
 

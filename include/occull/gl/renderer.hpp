@@ -189,6 +189,17 @@ class Renderer final : public Backend {
   /// Queries in flight (issued and not yet read by result()).
   [[nodiscard]] std::size_t queries_in_flight() const noexcept;
 
+  /// The GL objects the renderer holds (occull soak watches them grow).
+  struct Resources {
+    std::size_t queries = 0;       ///< occlusion query objects created (the pool: in use and free)
+    std::size_t queries_free = 0;  ///< ... of them free for the next issue_query()
+    std::size_t buffers = 0;       ///< buffer objects
+    std::int64_t buffer_bytes = 0; ///< their sizes as GL reports them (GL_BUFFER_SIZE), bytes
+  };
+  /// Precondition: the renderer's context is current; not between
+  /// begin_frame() and end_frame() (it binds nothing, but reads GL state).
+  [[nodiscard]] Resources resources() const;
+
   [[nodiscard]] int width() const noexcept;
   [[nodiscard]] int height() const noexcept;
 

@@ -1,0 +1,91 @@
+// occull — soak runs: one walk looped for a long time per culler, watching
+// what must not grow (resident memory, the heap, the GL query pool and
+// buffers) and how the frame time drifts, window by window.
+#pragma once
+
+#include "occull/culler.hpp"
+#include "occull/gl/context.hpp"
+#include "occull/gl/renderer.hpp"
+#include "occull/harness.hpp"
+
+#include <cstdint>
+#include <functional>
+#include <iosfwd>
+#include <string>
+#include <vector>
+
+namespace occull {
+
+struct SoakConfig {
+  std::string scene = "city";  ///< scene spec (make_scene); its dynamic objects move all along
+  std::string path;            ///< camera path, looped (empty: `turn` where the scene has one, else its first)
+  std::vector<std::string> algorithms = {"chcpp", "nohc", "grid"};  ///< specs, run one after another
+  std::int64_t frames = 100000;  ///< measured frames per algorithm, a whole number of windows
+  std::int64_t window = 10000;   ///< frames per reported window, >= 1
+  std::int64_t warmup = 1000;    ///< frames before the first window (caches, pools filling), >= 0
+  double fps = 30.0;             ///< frame k is at k / fps seconds, the path's time modulo its duration; > 0
+  gl::RendererOptions renderer;  ///< render size and query setup
+  gl::ContextOptions context;    ///< e.g. debug output (--gl-debug)
+  Options options;               ///< algorithm options
+  double stall_guard_ms = 0.0;   ///< Session::set_stall_guard
+  double watchdog_s = Session::kWatchdogSeconds;
+  /// Flat: the last window's end is within this share above the first's
+  /// (resident memory, queries created, buffer bytes; see judge_soak_run).
+  double tolerance = 0.05;
+};
+
+/// One window of frames of one algorithm. Memory and GL figures are taken
+/// at the window's end.
+struct SoakWindow {
+  std::int64_t first_frame = 0;  ///< counted from the end of the warm-up
+  std::int64_t frames = 0;
+  double median_ms = 0.0, p95_ms = 0.0, max_ms = 0.0;  ///< frame time (FrameStats::frame_ms)
+  double queries_per_frame = 0.0;
+  std::uint64_t resident_bytes = 0;  ///< MemoryUsage of the whole process
+  std::uint64_t heap_bytes = 0;
+  gl::Renderer::Resources gl;        ///< the renderer's query pool and buffers
+};
+
+struct SoakRun {
+  std::string algorithm;
+  std::vector<SoakWindow> windows;
+  double time_drift = 1.0;  ///< last window's median frame time over the first's
+  bool memory_flat = true;  ///< resident memory: last window within tolerance of the first
+  bool pool_flat = true;    ///< queries created and buffer bytes: likewise
+};
+
+/// Sets `run`'s verdicts from its first and last windows. Memory is judged
+/// on the resident set: under the engine allocator policy freed memory is
+/// kept, so it is the process's high-water mark and only grows for good;
+/// the heap in use is reported but not judged (it swings by tens of MiB
+/// with what the driver holds at the moment it is read). The query pool
+/// is the most queries ever in use at once, so it may creep up with a rare
+/// peak; a leak grows it by the frames.
+void judge_soak_run(SoakRun& run, double tolerance);
+
+struct SoakResult {
+  SoakConfig config;
+  std::string scene, path;  ///< the scene's and path's names
+  double path_seconds = 0.0;
+  std::string renderer;     ///< "renderer | version"
+  std::vector<SoakRun> runs;
+};
+
+/// (algorithm, frames done, frames in all, counting the warm-up); called
+/// every few hundred frames.
+using SoakProgress = std::function<void(const std::string&, std::int64_t, std::int64_t)>;
+
+/// Runs every algorithm of `config` for warmup + frames frames, each with a
+/// fresh renderer, without verification (a soak watches growth; bench
+/// verifies). Throws InputError for a bad config (frames not a positive
+/// multiple of window, fps not > 0, unknown names), GlUnavailable.
+[[nodiscard]] SoakResult run_soak(const SoakConfig& config, const SoakProgress& progress = {});
+
+/// A table per algorithm (a row per window) and a verdict line each.
+void print_soak(const SoakResult& result, std::ostream& out);
+/// The same as JSON ("format": "occull soak 1").
+void write_soak_json(const SoakResult& result, std::ostream& out);
+/// Whether every run's memory and GL objects stayed flat.
+[[nodiscard]] bool soak_flat(const SoakResult& result) noexcept;
+
+}  // namespace occull

@@ -1,0 +1,177 @@
+// occull soak: a looped walk per culler for many frames, a row per window
+// of what must stay flat (memory, the query pool, buffers) and how the
+// frame time drifts.
+#include "occull/soak.hpp"
+
+#include "occull/error.hpp"
+#include "occull/process.hpp"
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include <cmath>
+#include <ostream>
+
+namespace occull {
+namespace {
+
+double mib(std::uint64_t bytes) { return double(bytes) / double(1 << 20); }
+
+// Whether `last` is within `tolerance` above `first` (a figure the OS or C
+// library did not give, 0, is not judged).
+bool within(double first, double last, double tolerance) {
+  return first <= 0.0 || last <= first * (1.0 + tolerance);
+}
+
+void check(const SoakConfig& c) {
+  if (c.window < 1) throw InputError(fmt::format("soak window {}: must be at least 1 frame", c.window));
+  if (c.frames < c.window || c.frames % c.window != 0)
+    throw InputError(fmt::format("soak frames {}: must be a positive multiple of the window ({} frames)", c.frames,
+                                 c.window));
+  if (c.warmup < 0) throw InputError(fmt::format("soak warm-up {}: must be >= 0 frames", c.warmup));
+  if (!(c.fps > 0.0) || !std::isfinite(c.fps)) throw InputError(fmt::format("soak fps {}: must be > 0", c.fps));
+  if (!(c.tolerance >= 0.0)) throw InputError(fmt::format("soak tolerance {}: must be >= 0", c.tolerance));
+  if (c.algorithms.empty()) throw InputError("soak: no algorithms");
+}
+
+SoakRun soak_one(Session& session, const std::string& name, const SoakConfig& c, const CameraPath& path,
+                 const SoakProgress& progress) {
+  session.reset_renderer();
+  session.set_stall_guard(c.stall_guard_ms);
+  auto culler = session.make(name, c.options);
+  SoakRun run{name, {}, 1.0, true, true};
+  const double loop = path.duration();
+  const std::int64_t total = c.warmup + c.frames;
+  std::vector<double> ms;
+  ms.reserve(std::size_t(c.window));
+  std::uint64_t queries = 0;
+  for (std::int64_t k = 0; k < total; ++k) {
+    const double t = double(k) / c.fps;
+    const double on_path = loop > 0.0 ? std::fmod(t, loop) : 0.0;
+    const View view = make_view(path.sample(path.keys().front().time + on_path), session.bundle().lens,
+                                session.renderer().width(), session.renderer().height());
+    const FrameStats s = session.run_frame(*culler, view, t);
+    if (progress && (k % 500 == 0 || k + 1 == total)) progress(name, k + 1, total);
+    if (k < c.warmup) continue;
+    ms.push_back(s.frame_ms);
+    queries += s.queries;
+    if (std::int64_t(ms.size()) < c.window) continue;
+    SoakWindow w;
+    w.first_frame = k + 1 - c.warmup - c.window;
+    w.frames = c.window;
+    const Summary sum = summarize(ms);
+    w.median_ms = sum.median;
+    w.p95_ms = sum.p95;
+    w.max_ms = sum.max;
+    w.queries_per_frame = double(queries) / double(c.window);
+    const MemoryUsage m = memory_usage();
+    w.resident_bytes = m.resident_bytes;
+    w.heap_bytes = m.heap_bytes;
+    w.gl = session.renderer().resources();
+    run.windows.push_back(w);
+    ms.clear();
+    queries = 0;
+  }
+  judge_soak_run(run, c.tolerance);
+  return run;
+}
+
+}  // namespace
+
+void judge_soak_run(SoakRun& run, double tolerance) {
+  if (run.windows.empty()) return;
+  const SoakWindow& a = run.windows.front();
+  const SoakWindow& b = run.windows.back();
+  run.time_drift = a.median_ms > 0.0 ? b.median_ms / a.median_ms : 1.0;
+  run.memory_flat = within(double(a.resident_bytes), double(b.resident_bytes), tolerance);
+  run.pool_flat = within(double(a.gl.queries), double(b.gl.queries), tolerance) &&
+                  within(double(a.gl.buffer_bytes), double(b.gl.buffer_bytes), tolerance);
+}
+
+SoakResult run_soak(const SoakConfig& config, const SoakProgress& progress) {
+  check(config);
+  for (const auto& name : config.algorithms) (void)parse_algorithm_spec(name, config.options);
+  Session session(config.scene, config.renderer, {}, config.context);
+  session.set_watchdog(config.watchdog_s);
+  std::string path_name = config.path;
+  if (path_name.empty())
+    for (const CameraPath& p : session.bundle().paths)
+      if (p.name() == "turn") path_name = p.name();
+  const CameraPath& path = session.path(path_name);
+  SoakResult result;
+  result.config = config;
+  result.scene = session.bundle().scene.name();
+  result.path = path.name();
+  result.path_seconds = path.duration();
+  result.renderer = session.renderer_key();
+  for (const auto& name : config.algorithms) (void)session.make(name, config.options);  // options, profile: early
+  for (const auto& name : config.algorithms) result.runs.push_back(soak_one(session, name, config, path, progress));
+  return result;
+}
+
+bool soak_flat(const SoakResult& result) noexcept {
+  for (const SoakRun& r : result.runs)
+    if (!r.memory_flat || !r.pool_flat) return false;
+  return true;
+}
+
+void print_soak(const SoakResult& result, std::ostream& out) {
+  const SoakConfig& c = result.config;
+  out << fmt::format("soak: {} / {} ({:.1f} s, looped) at {} fps, {}x{}, {} warm-up + {} frames per algorithm, "
+                     "windows of {}\nrenderer: {}\n",
+                     result.scene, result.path, result.path_seconds, c.fps, c.renderer.width, c.renderer.height,
+                     c.warmup, c.frames, c.window, result.renderer);
+  for (const SoakRun& r : result.runs) {
+    out << fmt::format("\n{}\n{:>9} {:>9} {:>8} {:>8} {:>9} {:>9} {:>9} {:>8} {:>8} {:>9}\n", r.algorithm, "frames",
+                       "median ms", "p95 ms", "max ms", "queries/f", "RSS MiB", "heap MiB", "queries", "free",
+                       "buf MiB");
+    for (const SoakWindow& w : r.windows)
+      out << fmt::format("{:>9} {:>9.3f} {:>8.3f} {:>8.2f} {:>9.1f} {:>9.1f} {:>9.1f} {:>8} {:>8} {:>9.2f}\n",
+                         fmt::format("{}k", (w.first_frame + w.frames) / 1000.0), w.median_ms, w.p95_ms, w.max_ms,
+                         w.queries_per_frame, mib(w.resident_bytes), mib(w.heap_bytes), w.gl.queries,
+                         w.gl.queries_free, mib(std::uint64_t(w.gl.buffer_bytes)));
+    const SoakWindow& a = r.windows.front();
+    const SoakWindow& b = r.windows.back();
+    out << fmt::format("{}: memory {} (RSS {:+.1f}%), query pool and buffers {} ({} -> {} queries), "
+                       "median frame time x{:.3f}, last window vs first\n",
+                       r.algorithm, r.memory_flat ? "flat" : "GREW",
+                       a.resident_bytes ? 100.0 * (double(b.resident_bytes) / double(a.resident_bytes) - 1.0) : 0.0,
+                       r.pool_flat ? "flat" : "GREW", a.gl.queries, b.gl.queries, r.time_drift);
+  }
+  out << fmt::format("\nverdict: {} (flat: the last window's end within {:.0f}% of the first's)\n",
+                     soak_flat(result) ? "flat" : "GREW", 100.0 * c.tolerance);
+}
+
+void write_soak_json(const SoakResult& result, std::ostream& out) {
+  using nlohmann::json;
+  const SoakConfig& c = result.config;
+  json doc;
+  doc["format"] = "occull soak 1";
+  doc["scene"] = result.scene;
+  doc["path"] = result.path;
+  doc["path_seconds"] = result.path_seconds;
+  doc["renderer"] = result.renderer;
+  doc["size"] = {c.renderer.width, c.renderer.height};
+  doc["fps"] = c.fps;
+  doc["warmup"] = c.warmup;
+  doc["frames"] = c.frames;
+  doc["window"] = c.window;
+  doc["tolerance"] = c.tolerance;
+  doc["flat"] = soak_flat(result);
+  json runs = json::array();
+  for (const SoakRun& r : result.runs) {
+    json windows = json::array();
+    for (const SoakWindow& w : r.windows)
+      windows.push_back({{"first_frame", w.first_frame}, {"frames", w.frames}, {"median_ms", w.median_ms},
+                         {"p95_ms", w.p95_ms}, {"max_ms", w.max_ms}, {"queries_per_frame", w.queries_per_frame},
+                         {"resident_bytes", w.resident_bytes}, {"heap_bytes", w.heap_bytes},
+                         {"gl_queries", w.gl.queries}, {"gl_queries_free", w.gl.queries_free},
+                         {"gl_buffers", w.gl.buffers}, {"gl_buffer_bytes", w.gl.buffer_bytes}});
+    runs.push_back({{"algorithm", r.algorithm}, {"memory_flat", r.memory_flat}, {"pool_flat", r.pool_flat},
+                    {"time_drift", r.time_drift}, {"windows", windows}});
+  }
+  doc["runs"] = runs;
+  out << doc.dump(2) << "\n";
+}
+
+}  // namespace occull

@@ -1,0 +1,92 @@
+// occull soak: its windows, its figures, and the verdicts on growth.
+#include "occull/error.hpp"
+#include "occull/soak.hpp"
+#include "gl_test_util.hpp"
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <sstream>
+
+using namespace occull;
+
+namespace {
+
+SoakConfig tiny() {
+  SoakConfig c;
+  c.scene = "city:blocks=3,traffic=3";
+  c.frames = 40;
+  c.window = 20;
+  c.warmup = 4;
+  c.renderer = test::small_target(64, 36);
+  return c;
+}
+
+SoakWindow window(std::uint64_t resident, std::size_t queries) {
+  SoakWindow w;
+  w.median_ms = 1.0;
+  w.resident_bytes = resident;
+  w.gl.queries = queries;
+  w.gl.buffer_bytes = 1000;
+  return w;
+}
+
+}  // namespace
+
+TEST(Soak, RunsEveryAlgorithmOverItsWindowsOnTheTurnPathReportingMemoryAndGlObjects) {
+  const SoakResult r = run_soak(tiny());
+  EXPECT_EQ(r.path, "turn");
+  ASSERT_EQ(r.runs.size(), 3u);
+  for (const SoakRun& run : r.runs) {
+    ASSERT_EQ(run.windows.size(), 2u) << run.algorithm;
+    EXPECT_EQ(run.windows[1].first_frame, 20);
+    for (const SoakWindow& w : run.windows) {
+      EXPECT_GT(w.median_ms, 0.0) << run.algorithm;
+      EXPECT_GT(w.resident_bytes, 0u) << run.algorithm;
+      EXPECT_GT(w.queries_per_frame, 0.0) << run.algorithm;
+      EXPECT_GT(w.gl.queries, 0u) << run.algorithm;  // the pool served those queries
+      EXPECT_LE(w.gl.queries_free, w.gl.queries) << run.algorithm;
+      EXPECT_EQ(w.gl.buffers, 7u) << run.algorithm;
+      EXPECT_GT(w.gl.buffer_bytes, 0) << run.algorithm;
+    }
+  }
+  std::ostringstream text, json;
+  print_soak(r, text);
+  EXPECT_NE(text.str().find("verdict:"), std::string::npos) << text.str();
+  write_soak_json(r, json);
+  const auto doc = nlohmann::json::parse(json.str());
+  EXPECT_EQ(doc["format"], "occull soak 1");
+  EXPECT_EQ(doc["runs"].size(), 3u);
+  EXPECT_EQ(doc["runs"][0]["windows"][0]["gl_buffers"], 7);
+}
+
+TEST(Soak, MemoryThatGrowsPastTheToleranceIsJudgedGrown) {
+  SoakRun run;
+  run.windows = {window(100 << 20, 50), window(104 << 20, 50)};
+  judge_soak_run(run, 0.05);
+  EXPECT_TRUE(run.memory_flat);
+  run.windows.push_back(window(106 << 20, 50));
+  judge_soak_run(run, 0.05);
+  EXPECT_FALSE(run.memory_flat);
+  EXPECT_TRUE(run.pool_flat);
+}
+
+TEST(Soak, AQueryPoolThatGrowsPastTheToleranceIsJudgedGrown) {
+  SoakRun run;
+  run.windows = {window(100 << 20, 100), window(100 << 20, 105)};
+  judge_soak_run(run, 0.05);
+  EXPECT_TRUE(run.pool_flat);
+  run.windows.push_back(window(100 << 20, 106));
+  judge_soak_run(run, 0.05);
+  EXPECT_FALSE(run.pool_flat);
+  EXPECT_TRUE(run.memory_flat);
+}
+
+TEST(Soak, FramesThatAreNotAWholeNumberOfWindowsAreRejected) {
+  SoakConfig c = tiny();
+  c.frames = 30;
+  EXPECT_THROW((void)run_soak(c), InputError);
+  c.frames = 40;
+  c.fps = 0.0;
+  EXPECT_THROW((void)run_soak(c), InputError);
+}
