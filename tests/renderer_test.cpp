@@ -566,3 +566,33 @@ TEST(GlDebug, ABenchRunWithGlDebugReportsNoErrors) {
   config.gl_debug = true;
   EXPECT_NO_THROW((void)run_bench(config));
 }
+
+TEST_F(RendererTest, AnEmptySceneDrawsTheBackgroundAndItsTruthIsEmpty) {
+  const Scene scene("empty");
+  gl::Renderer r(scene, small());
+  const View view = make_view({{0, 0, 0}, 0, 0}, {60.0f, 0.1f, 100.0f}, kSize, kSize);
+  r.begin_frame(view);
+  const QueryId q = r.issue_query(std::vector<Aabb>{{{-1, -1, -6}, {1, 1, -5}}});
+  EXPECT_GT(r.result(q), 0u) << "nothing in front of the box";
+  r.end_frame();
+  EXPECT_TRUE(ids_in(r.read_ids()).empty());
+  EXPECT_TRUE(r.visible_pixels(view, {}).empty());
+}
+
+TEST_F(RendererTest, ATargetOfZeroOrMoreThanTheLimitIsAnErrorNamingIt) {
+  const WallScene w;
+  for (const auto& [width, height] : {std::pair{0, 64}, std::pair{64, 0}, std::pair{16385, 64}}) {
+    gl::RendererOptions o = small();
+    o.width = width;
+    o.height = height;
+    try {
+      gl::Renderer r(w.scene, o);
+      ADD_FAILURE() << width << "x" << height << " was accepted";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(fmt::format("render target {}x{}: each side must be in [1, 16384]", width,
+                                                       height)),
+                std::string::npos)
+          << e.what();
+    }
+  }
+}

@@ -17,6 +17,7 @@
 #include "occull/profile_io.hpp"
 #include "occull/q3bsp.hpp"
 #include "occull/harness.hpp"
+#include "occull/input_limits.hpp"
 #include "occull/report.hpp"
 #include "occull/scenes.hpp"
 #include "occull/soak.hpp"
@@ -62,8 +63,9 @@ Size parse_size(const std::string& text) {
   char x = 0, extra = 0;
   if (std::sscanf(text.c_str(), "%d%c%d%c", &w, &x, &h, &extra) != 3 || (x != 'x' && x != 'X'))
     throw occull::InputError(fmt::format("--size '{}' is not WIDTHxHEIGHT (e.g. 1280x720)", text));
-  if (w < 1 || h < 1 || w > 16384 || h > 16384)
-    throw occull::InputError(fmt::format("--size {}x{}: each side must be in [1, 16384]", w, h));
+  if (w < 1 || h < 1 || w > occull::limits::viewport_side || h > occull::limits::viewport_side)
+    throw occull::InputError(
+        fmt::format("--size {}x{}: each side must be in [1, {}]", w, h, occull::limits::viewport_side));
   return {w, h};
 }
 

@@ -83,7 +83,8 @@ class Bvh {
   /// level by level down to `d_max` levels below `n` (objects of a real leaf
   /// count as the level below it), as long as the sum of their surface areas
   /// stays at most `s_max` times the node's. Appends the boxes to `out`
-  /// (at least one box). Preconditions: d_max >= 0, s_max >= 1.
+  /// (at least one for a node whose box is not empty: empty boxes, of objects
+  /// without triangles, are left out). Preconditions: d_max >= 0, s_max >= 1.
   void gather_tight_boxes(NodeId n, int d_max, float s_max, const Scene& scene,
                           std::vector<Aabb>& out) const;
 

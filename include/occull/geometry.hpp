@@ -70,7 +70,8 @@ struct Aabb {
 };
 
 /// The box of `b` after an affine transform `m` (the box of its 8 transformed
-/// corners). Exact for rotations by multiples of 90 degrees.
+/// corners). Exact for rotations by multiples of 90 degrees. An empty box stays
+/// empty.
 [[nodiscard]] Aabb transform_box(const Aabb& b, const glm::mat4& m) noexcept;
 
 /// Euclidean distance from point `p` to the box (0 when p is inside).
@@ -110,6 +111,7 @@ class Frustum {
 
   /// Classifies a box. Conservative: may answer `intersecting` for a box that
   /// is outside near a frustum corner, never `outside` for a box that overlaps.
+  /// An empty box is `outside`.
   /// `plane_mask` selects the planes to test (bit i = plane i); on return it
   /// holds the planes the box still straddles, so children of an
   /// `intersecting` node can skip the planes their parent was fully inside.

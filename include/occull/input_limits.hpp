@@ -29,6 +29,9 @@ inline constexpr std::uint64_t archive_bytes = std::uint64_t(4) << 30;
 inline constexpr std::uint64_t model_bytes = std::uint64_t(512) << 20;
 /// A text file: a recorded path (.path) or a hardware profile (JSON).
 inline constexpr std::uint64_t text_file_bytes = std::uint64_t(16) << 20;
+/// A viewport's or render target's side, pixels (GL_MAX_RENDERBUFFER_SIZE
+/// of common drivers).
+inline constexpr int viewport_side = 16384;
 /// A scene spec ("city:blocks=40,...") or an algorithm spec, in characters.
 inline constexpr std::size_t spec_chars = 4096;
 /// Objects in one scene (Scene::add_object).

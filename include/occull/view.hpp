@@ -42,7 +42,10 @@ struct CameraPose {
 [[nodiscard]] float near_plane_radius(const View& view);
 
 /// The view of `pose` through `lens` on a width x height viewport.
-/// Preconditions: width > 0, height > 0, |pitch| < pi/2.
+/// Throws InputError, naming the value, for a pose that is not finite, a
+/// |pitch| not below pi/2, a field of view outside (0, 180) degrees, a lens
+/// without 0 < near < far < infinity (a near plane of 0 leaves the depth
+/// buffer no precision), or a side outside [1, limits::viewport_side].
 [[nodiscard]] View make_view(const CameraPose& pose, const Lens& lens, int width, int height);
 
 /// Where the frames of a run lie on a camera path.

@@ -226,7 +226,8 @@ void Bvh::gather_tight_boxes(NodeId n, int d_max, float s_max, const Scene& scen
     if (!expanded || area > limit) break;
     std::swap(current, next);
   }
-  for (const Entry& e : current) out.push_back(e.box);
+  for (const Entry& e : current)
+    if (!e.box.empty()) out.push_back(e.box);  // an object without triangles has nothing to query
 }
 
 double Bvh::sah_cost(float traversal_cost) const {

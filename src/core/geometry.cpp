@@ -21,6 +21,7 @@ float Aabb::volume() const noexcept {
 Aabb transform_box(const Aabb& b, const glm::mat4& m) noexcept {
   // Arvo's method: each output axis is the sum of the extremes of the
   // products of one matrix row with the box interval.
+  if (b.empty()) return {};  // infinities times zero entries would make NaN, or a box of everything
   Aabb out;
   const glm::vec3 t(m[3]);
   out.min = t;
@@ -60,6 +61,7 @@ Frustum Frustum::from_view_projection(const glm::mat4& m) noexcept {
 }
 
 Containment Frustum::classify(const Aabb& box, std::uint32_t& plane_mask) const noexcept {
+  if (box.empty()) return Containment::outside;  // nothing to see (an object without triangles)
   for (int i = 0; i < count; ++i) {
     const std::uint32_t bit = 1u << i;
     if (!(plane_mask & bit)) continue;

@@ -68,7 +68,8 @@ HardwareProfile profile_from_json(std::string_view text, std::string_view source
       !doc["size"][0].is_number_integer() || !doc["size"][1].is_number_integer())
     throw fail("\"size\" is not [width, height]");
   const auto w = doc["size"][0].get<std::int64_t>(), h = doc["size"][1].get<std::int64_t>();
-  if (w < 1 || h < 1 || w > 16384 || h > 16384) throw fail("\"size\" must be in [1, 16384] pixels per side");
+  if (w < 1 || h < 1 || w > limits::viewport_side || h > limits::viewport_side)
+    throw fail(fmt::format("\"size\" must be in [1, {}] pixels per side", limits::viewport_side));
   p.width = int(w);
   p.height = int(h);
   for (const char* key : kTimes) {

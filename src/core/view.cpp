@@ -1,5 +1,9 @@
 #include "occull/view.hpp"
 
+#include "occull/error.hpp"
+#include "occull/input_limits.hpp"
+
+#include <fmt/format.h>
 #include <glm/gtc/constants.hpp>
 #include <glm/gtc/matrix_transform.hpp>
 
@@ -11,7 +15,22 @@
 namespace occull {
 
 View make_view(const CameraPose& pose, const Lens& lens, int width, int height) {
-  assert(width > 0 && height > 0);
+  if (width < 1 || height < 1 || width > limits::viewport_side || height > limits::viewport_side)
+    throw InputError(fmt::format("viewport {}x{}: each side must be in [1, {}] pixels", width, height,
+                                 limits::viewport_side));
+  const glm::vec3& p = pose.position;
+  if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z) || !std::isfinite(pose.yaw) ||
+      !std::isfinite(pose.pitch))
+    throw InputError(fmt::format("camera at ({}, {}, {}) with yaw {} and pitch {} rad: every number must be finite",
+                                 p.x, p.y, p.z, pose.yaw, pose.pitch));
+  if (!(std::abs(pose.pitch) < glm::half_pi<float>()))
+    throw InputError(fmt::format("camera pitch {} rad: must be within (-pi/2, pi/2)", pose.pitch));
+  if (!(lens.fov_y_degrees > 0.0f && lens.fov_y_degrees < 180.0f))
+    throw InputError(fmt::format("lens field of view {} degrees: must be within (0, 180)", lens.fov_y_degrees));
+  if (!(lens.near > 0.0f && lens.far > lens.near && std::isfinite(lens.far)))
+    throw InputError(fmt::format("lens near {} far {}: needs 0 < near < far < infinity (a near plane of 0 leaves "
+                                 "the depth buffer no precision)",
+                                 lens.near, lens.far));
   View v;
   v.eye = pose.position;
   const float cp = std::cos(pose.pitch);

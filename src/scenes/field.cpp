@@ -77,7 +77,7 @@ SceneInfo field_info() {
   return {"field",
           "open rolling ground with trees, rocks, houses and haystacks scattered on it: low depth "
           "complexity",
-          {{"objects", 5000, 10, 200000, true, "objects scattered on the ground"},
+          {{"objects", 5000, 10, 1000000, true, "objects scattered on the ground (instances of 9 meshes)"},
            {"size", 800, 100, 10000, false, "side of the square field, metres"},
            {"shading", 0, 0, 64, true, "light evaluations per fragment (fragment cost)"},
            {"seed", 1, 0, 1e9, true, "random seed"}},

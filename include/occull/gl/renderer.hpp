@@ -41,7 +41,7 @@ enum class QueryRaster : std::uint8_t {
 };
 
 struct RendererOptions {
-  int width = 1280;   ///< render-target size in pixels, 1..16384
+  int width = 1280;   ///< render-target size in pixels, 1..limits::viewport_side (else Renderer throws InputError)
   int height = 720;
   QueryMode query_mode = QueryMode::samples_passed;
   bool write_ids = true;       ///< also write object ids (id + 1) into the R32UI target
