@@ -560,3 +560,24 @@ TEST(Cli, SoakPrintsAWindowRowPerAlgorithmAndAVerdictAndRejectsAPartialWindow) {
   EXPECT_EQ(bad.code, 2);
   EXPECT_NE(bad.output.find("must be a positive multiple of the window"), std::string::npos) << bad.output;
 }
+
+TEST(Cli, TheExitCodesOfTheReadmeAreTheOnesTheHelpAndTheToolUse) {
+  // The README's table and --help must list the same codes, 0 to 5.
+  std::ifstream readme(std::string(OCCULL_SOURCE_DIR) + "/README.md");
+  std::string line;
+  while (std::getline(readme, line) && line != "### Exit codes") {}
+  std::vector<int> documented;
+  while (std::getline(readme, line) && line.rfind("## ", 0) != 0)
+    if (line.size() > 2 && line[0] == '|' && std::isdigit(static_cast<unsigned char>(line[2])))
+      documented.push_back(line[2] - '0');
+  EXPECT_EQ(documented, (std::vector<int>{0, 1, 2, 3, 4, 5}));
+  const CliRun help = run("--help");
+  for (const char* code : {"0 success", "1 internal error", "2 bad input", "3 no usable OpenGL", "4 a conservative",
+                           "5 memory or the query pool grew"})
+    EXPECT_NE(help.output.find(code), std::string::npos) << code;
+  // And the tool uses them: 0, 2 here; 1 (watchdog), 3 (no EGL driver),
+  // 5 (soak) in their own tests; 4 is verification_failures() of a run
+  // (Verdict.MissesOfConservativeRunsFailThoseOfOthersArePopping).
+  EXPECT_EQ(run("algos").code, 0);
+  EXPECT_EQ(run("bench --scene nope").code, 2);
+}
