@@ -34,7 +34,8 @@ SoakWindow window(std::uint64_t resident, std::size_t queries) {
 }  // namespace
 
 TEST(Soak, RunsEveryAlgorithmOverItsWindowsOnTheTurnPathReportingMemoryAndGlObjects) {
-  const SoakResult r = run_soak(tiny());
+  std::ostringstream live;
+  const SoakResult r = run_soak(tiny(), {}, &live);
   EXPECT_EQ(r.path, "turn");
   ASSERT_EQ(r.runs.size(), 3u);
   for (const SoakRun& run : r.runs) {
@@ -52,6 +53,7 @@ TEST(Soak, RunsEveryAlgorithmOverItsWindowsOnTheTurnPathReportingMemoryAndGlObje
   }
   std::ostringstream text, json;
   print_soak(r, text);
+  EXPECT_EQ(live.str(), text.str()) << "the table printed as it ran is the table of the result";
   EXPECT_NE(text.str().find("verdict:"), std::string::npos) << text.str();
   write_soak_json(r, json);
   const auto doc = nlohmann::json::parse(json.str());

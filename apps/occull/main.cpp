@@ -604,16 +604,16 @@ int cmd_soak(const SoakArgs& a) {
   const auto json = open_output(a.json);
   const bool tty = isatty(fileno(stderr)) != 0;
   const auto start = std::chrono::steady_clock::now();
-  const occull::SoakResult result = occull::run_soak(c, [&](const std::string& algo, std::int64_t k, std::int64_t n) {
+  std::cout << "allocator: " << allocator << "\n";
+  const auto progress = [&](const std::string& algo, std::int64_t k, std::int64_t n) {
     if (!tty && k % 5000 != 1 && k != n) return;
     const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     std::fprintf(stderr, "%s[%s] frame %lld/%lld, %.0f s%s", tty ? "\r" : "", algo.c_str(), (long long)k,
                  (long long)n, s, tty && k != n ? "   " : "\n");
     std::fflush(stderr);
-  });
-  std::cout << "allocator: " << allocator << "\n";
-  occull::print_soak(result, std::cout);
-  std::cout.flush();
+  };
+  // The table is printed as the run goes: rows of a run that dies stay.
+  const occull::SoakResult result = occull::run_soak(c, progress, &std::cout);
   if (json) {
     occull::write_soak_json(result, *json);
     json->flush();

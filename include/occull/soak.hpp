@@ -77,12 +77,22 @@ using SoakProgress = std::function<void(const std::string&, std::int64_t, std::i
 
 /// Runs every algorithm of `config` for warmup + frames frames, each with a
 /// fresh renderer, without verification (a soak watches growth; bench
-/// verifies). Throws InputError for a bad config (frames not a positive
-/// multiple of window, fps not > 0, unknown names), GlUnavailable.
-[[nodiscard]] SoakResult run_soak(const SoakConfig& config, const SoakProgress& progress = {});
+/// verifies). With `live`, prints print_soak()'s table there as the run
+/// goes, each row when its window ends (a run that dies keeps its rows).
+/// Throws InputError for a bad config (frames not a positive multiple of
+/// window, fps not > 0, unknown names), GlUnavailable.
+[[nodiscard]] SoakResult run_soak(const SoakConfig& config, const SoakProgress& progress = {},
+                                  std::ostream* live = nullptr);
 
-/// A table per algorithm (a row per window) and a verdict line each.
+/// A table per algorithm (a row per window) and a verdict line each, then
+/// the verdict: soak_header, then per run soak_columns, soak_row per window
+/// and soak_run_verdict, then soak_verdict.
 void print_soak(const SoakResult& result, std::ostream& out);
+[[nodiscard]] std::string soak_header(const SoakResult& result);
+[[nodiscard]] std::string soak_columns(const std::string& algorithm);
+[[nodiscard]] std::string soak_row(const SoakWindow& window);
+[[nodiscard]] std::string soak_run_verdict(const SoakRun& run);
+[[nodiscard]] std::string soak_verdict(const SoakResult& result);
 /// The same as JSON ("format": "occull soak 1").
 void write_soak_json(const SoakResult& result, std::ostream& out);
 /// Whether every run's memory and GL objects stayed flat.

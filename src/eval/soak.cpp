@@ -34,12 +34,13 @@ void check(const SoakConfig& c) {
   if (c.algorithms.empty()) throw InputError("soak: no algorithms");
 }
 
-SoakRun soak_one(Session& session, const std::string& name, const SoakConfig& c, const CameraPath& path,
-                 const SoakProgress& progress) {
+void soak_one(Session& session, SoakRun& run, const SoakConfig& c, const CameraPath& path,
+              const SoakProgress& progress, std::ostream* live) {
+  const std::string& name = run.algorithm;
   session.reset_renderer();
   session.set_stall_guard(c.stall_guard_ms);
   auto culler = session.make(name, c.options);
-  SoakRun run{name, {}, 1.0, true, true};
+  if (live) *live << soak_columns(name) << std::flush;
   const double loop = path.duration();
   const std::int64_t total = c.warmup + c.frames;
   std::vector<double> ms;
@@ -69,11 +70,12 @@ SoakRun soak_one(Session& session, const std::string& name, const SoakConfig& c,
     w.heap_bytes = m.heap_bytes;
     w.gl = session.renderer().resources();
     run.windows.push_back(w);
+    if (live) *live << soak_row(w) << std::flush;
     ms.clear();
     queries = 0;
   }
   judge_soak_run(run, c.tolerance);
-  return run;
+  if (live) *live << soak_run_verdict(run) << std::flush;
 }
 
 }  // namespace
@@ -88,7 +90,7 @@ void judge_soak_run(SoakRun& run, double tolerance) {
                   within(double(a.gl.buffer_bytes), double(b.gl.buffer_bytes), tolerance);
 }
 
-SoakResult run_soak(const SoakConfig& config, const SoakProgress& progress) {
+SoakResult run_soak(const SoakConfig& config, const SoakProgress& progress, std::ostream* live) {
   check(config);
   for (const auto& name : config.algorithms) (void)parse_algorithm_spec(name, config.options);
   Session session(config.scene, config.renderer, {}, config.context);
@@ -105,8 +107,50 @@ SoakResult run_soak(const SoakConfig& config, const SoakProgress& progress) {
   result.path_seconds = path.duration();
   result.renderer = session.renderer_key();
   for (const auto& name : config.algorithms) (void)session.make(name, config.options);  // options, profile: early
-  for (const auto& name : config.algorithms) result.runs.push_back(soak_one(session, name, config, path, progress));
+  if (live) *live << soak_header(result) << std::flush;
+  result.runs.reserve(config.algorithms.size());
+  for (const auto& name : config.algorithms) {
+    result.runs.push_back({name, {}, 1.0, true, true});
+    soak_one(session, result.runs.back(), config, path, progress, live);
+  }
+  if (live) *live << soak_verdict(result) << std::flush;
   return result;
+}
+
+std::string soak_header(const SoakResult& result) {
+  const SoakConfig& c = result.config;
+  return fmt::format("soak: {} / {} ({:.1f} s, looped) at {} fps, {}x{}, {} warm-up + {} frames per algorithm, "
+                     "windows of {}\nrenderer: {}\n",
+                     result.scene, result.path, result.path_seconds, c.fps, c.renderer.width, c.renderer.height,
+                     c.warmup, c.frames, c.window, result.renderer);
+}
+
+std::string soak_columns(const std::string& algorithm) {
+  return fmt::format("\n{}\n{:>9} {:>9} {:>8} {:>8} {:>9} {:>9} {:>9} {:>8} {:>8} {:>9}\n", algorithm, "frames",
+                     "median ms", "p95 ms", "max ms", "queries/f", "RSS MiB", "heap MiB", "queries", "free", "buf MiB");
+}
+
+std::string soak_row(const SoakWindow& w) {
+  return fmt::format("{:>9} {:>9.3f} {:>8.3f} {:>8.2f} {:>9.1f} {:>9.1f} {:>9.1f} {:>8} {:>8} {:>9.2f}\n",
+                     fmt::format("{}k", double(w.first_frame + w.frames) / 1000.0), w.median_ms, w.p95_ms, w.max_ms,
+                     w.queries_per_frame, mib(w.resident_bytes), mib(w.heap_bytes), w.gl.queries, w.gl.queries_free,
+                     mib(std::uint64_t(w.gl.buffer_bytes)));
+}
+
+std::string soak_run_verdict(const SoakRun& r) {
+  if (r.windows.empty()) return {};
+  const SoakWindow& a = r.windows.front();
+  const SoakWindow& b = r.windows.back();
+  return fmt::format("{}: memory {} (RSS {:+.1f}%), query pool and buffers {} ({} -> {} queries), "
+                     "median frame time x{:.3f}, last window vs first\n",
+                     r.algorithm, r.memory_flat ? "flat" : "GREW",
+                     a.resident_bytes ? 100.0 * (double(b.resident_bytes) / double(a.resident_bytes) - 1.0) : 0.0,
+                     r.pool_flat ? "flat" : "GREW", a.gl.queries, b.gl.queries, r.time_drift);
+}
+
+std::string soak_verdict(const SoakResult& result) {
+  return fmt::format("\nverdict: {} (flat: the last window's end within {:.0f}% of the first's)\n",
+                     soak_flat(result) ? "flat" : "GREW", 100.0 * result.config.tolerance);
 }
 
 bool soak_flat(const SoakResult& result) noexcept {
@@ -116,30 +160,13 @@ bool soak_flat(const SoakResult& result) noexcept {
 }
 
 void print_soak(const SoakResult& result, std::ostream& out) {
-  const SoakConfig& c = result.config;
-  out << fmt::format("soak: {} / {} ({:.1f} s, looped) at {} fps, {}x{}, {} warm-up + {} frames per algorithm, "
-                     "windows of {}\nrenderer: {}\n",
-                     result.scene, result.path, result.path_seconds, c.fps, c.renderer.width, c.renderer.height,
-                     c.warmup, c.frames, c.window, result.renderer);
+  out << soak_header(result);
   for (const SoakRun& r : result.runs) {
-    out << fmt::format("\n{}\n{:>9} {:>9} {:>8} {:>8} {:>9} {:>9} {:>9} {:>8} {:>8} {:>9}\n", r.algorithm, "frames",
-                       "median ms", "p95 ms", "max ms", "queries/f", "RSS MiB", "heap MiB", "queries", "free",
-                       "buf MiB");
-    for (const SoakWindow& w : r.windows)
-      out << fmt::format("{:>9} {:>9.3f} {:>8.3f} {:>8.2f} {:>9.1f} {:>9.1f} {:>9.1f} {:>8} {:>8} {:>9.2f}\n",
-                         fmt::format("{}k", (w.first_frame + w.frames) / 1000.0), w.median_ms, w.p95_ms, w.max_ms,
-                         w.queries_per_frame, mib(w.resident_bytes), mib(w.heap_bytes), w.gl.queries,
-                         w.gl.queries_free, mib(std::uint64_t(w.gl.buffer_bytes)));
-    const SoakWindow& a = r.windows.front();
-    const SoakWindow& b = r.windows.back();
-    out << fmt::format("{}: memory {} (RSS {:+.1f}%), query pool and buffers {} ({} -> {} queries), "
-                       "median frame time x{:.3f}, last window vs first\n",
-                       r.algorithm, r.memory_flat ? "flat" : "GREW",
-                       a.resident_bytes ? 100.0 * (double(b.resident_bytes) / double(a.resident_bytes) - 1.0) : 0.0,
-                       r.pool_flat ? "flat" : "GREW", a.gl.queries, b.gl.queries, r.time_drift);
+    out << soak_columns(r.algorithm);
+    for (const SoakWindow& w : r.windows) out << soak_row(w);
+    out << soak_run_verdict(r);
   }
-  out << fmt::format("\nverdict: {} (flat: the last window's end within {:.0f}% of the first's)\n",
-                     soak_flat(result) ? "flat" : "GREW", 100.0 * c.tolerance);
+  out << soak_verdict(result);
 }
 
 void write_soak_json(const SoakResult& result, std::ostream& out) {
