@@ -63,9 +63,7 @@ Size parse_size(const std::string& text) {
   char x = 0, extra = 0;
   if (std::sscanf(text.c_str(), "%d%c%d%c", &w, &x, &h, &extra) != 3 || (x != 'x' && x != 'X'))
     throw occull::InputError(fmt::format("--size '{}' is not WIDTHxHEIGHT (e.g. 1280x720)", text));
-  if (w < 1 || h < 1 || w > occull::limits::viewport_side || h > occull::limits::viewport_side)
-    throw occull::InputError(
-        fmt::format("--size {}x{}: each side must be in [1, {}]", w, h, occull::limits::viewport_side));
+  occull::limits::check_viewport(w, h, "--size");
   return {w, h};
 }
 
@@ -597,8 +595,6 @@ int cmd_soak(const SoakArgs& a) {
   c.renderer.height = size.height;
   c.context.debug = a.gl_debug;
   c.options = parse_options(a.opts);
-  if (!(a.stall_guard >= 0.0)) throw occull::InputError("--stall-guard must be >= 0 milliseconds");
-  if (!(a.watchdog >= 0.0)) throw occull::InputError("--watchdog must be >= 0 seconds");
   c.stall_guard_ms = a.stall_guard;
   c.watchdog_s = a.watchdog;
   const auto json = open_output(a.json);

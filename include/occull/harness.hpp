@@ -196,13 +196,14 @@ class Session {
   /// Bounds every frame (a culler's, or one of the ground truth) to this
   /// many seconds of wall time: past it, the process says which frame hung
   /// and exits with 1 (a GL call that never returns cannot be unwound).
-  /// 0 turns it off. Default: kWatchdogSeconds.
+  /// 0 turns it off. Default: kWatchdogSeconds. Throws InputError for a
+  /// negative or non-finite time.
   void set_watchdog(double seconds);
   static constexpr double kWatchdogSeconds = 300.0;
 
   /// Culler frames get the renderer through a StallGuard of this many
   /// milliseconds (0, the default: none, results are waited for).
-  /// Precondition: timeout_ms >= 0.
+  /// Throws InputError for a negative or non-finite time.
   void set_stall_guard(double timeout_ms);
   /// What culler frames render through: the renderer, or its StallGuard.
   [[nodiscard]] Backend& backend() noexcept;

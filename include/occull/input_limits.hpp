@@ -47,6 +47,10 @@ inline constexpr std::uint64_t mesh_triangles = std::uint64_t(1) << 26;
 /// `limit`: "PATH: N bytes is past the limit of L bytes for WHAT".
 [[nodiscard]] std::string read_file(const std::string& path, std::uint64_t limit, std::string_view what);
 
+/// Throws InputError "WHAT WxH: each side must be in [1, viewport_side]
+/// pixels" unless both sides are in that range.
+void check_viewport(int width, int height, std::string_view what);
+
 /// Throws InputError when file `path` is larger than `limit` bytes (naming
 /// the file, its size, the limit and `what` it is); does nothing when it is
 /// not larger or cannot be inspected (the reader then reports that).

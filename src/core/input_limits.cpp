@@ -10,18 +10,17 @@
 
 namespace occull::limits {
 
-namespace {
-
-[[noreturn]] void too_large(const std::string& path, std::uint64_t size, std::uint64_t limit, std::string_view what) {
-  throw InputError(fmt::format("{}: {} bytes is past the limit of {} bytes for {}", path, size, limit, what));
+void check_viewport(int width, int height, std::string_view what) {
+  if (width < 1 || height < 1 || width > viewport_side || height > viewport_side)
+    throw InputError(
+        fmt::format("{} {}x{}: each side must be in [1, {}] pixels", what, width, height, viewport_side));
 }
-
-}  // namespace
 
 void check_file_size(const std::string& path, std::uint64_t limit, std::string_view what) {
   std::error_code ec;
   const std::uintmax_t size = std::filesystem::file_size(path, ec);
-  if (!ec && size > limit) too_large(path, size, limit, what);
+  if (!ec && size > limit)
+    throw InputError(fmt::format("{}: {} bytes is past the limit of {} bytes for {}", path, size, limit, what));
 }
 
 std::string read_file(const std::string& path, std::uint64_t limit, std::string_view what) {

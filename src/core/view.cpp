@@ -15,9 +15,7 @@
 namespace occull {
 
 View make_view(const CameraPose& pose, const Lens& lens, int width, int height) {
-  if (width < 1 || height < 1 || width > limits::viewport_side || height > limits::viewport_side)
-    throw InputError(fmt::format("viewport {}x{}: each side must be in [1, {}] pixels", width, height,
-                                 limits::viewport_side));
+  limits::check_viewport(width, height, "viewport");
   const glm::vec3& p = pose.position;
   if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z) || !std::isfinite(pose.yaw) ||
       !std::isfinite(pose.pitch))

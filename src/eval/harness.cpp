@@ -104,10 +104,14 @@ Session::Session(std::string_view scene_spec, const gl::RendererOptions& rendere
 }
 
 void Session::set_watchdog(double seconds) {
+  if (!(seconds >= 0.0) || !std::isfinite(seconds))
+    throw InputError(fmt::format("watchdog {} s: must be a number of seconds >= 0 (0: off)", seconds));
   watchdog_ = std::make_unique<detail::Watchdog>(seconds);
 }
 
 void Session::set_stall_guard(double timeout_ms) {
+  if (!(timeout_ms >= 0.0) || !std::isfinite(timeout_ms))
+    throw InputError(fmt::format("stall guard {} ms: must be a number of milliseconds >= 0 (0: off)", timeout_ms));
   stall_guard_ms_ = timeout_ms;
   guard_ = timeout_ms > 0.0 ? std::make_unique<StallGuard>(*renderer_, timeout_ms) : nullptr;
 }
@@ -640,12 +644,7 @@ BenchResult run_bench(const BenchConfig& config, const ProgressFn& progress) {
   Session session(config.scene, ropts, config.bvh, copts);
   session.set_fault_hooks(config.hooks);
   session.set_sampling(config.sampling);
-  if (!(config.stall_guard_ms >= 0.0) || !std::isfinite(config.stall_guard_ms))
-    throw InputError(fmt::format("stall guard {} ms: must be a number of milliseconds >= 0 (0: off)",
-                                 config.stall_guard_ms));
   session.set_stall_guard(config.stall_guard_ms);
-  if (!(config.watchdog_s >= 0.0) || !std::isfinite(config.watchdog_s))
-    throw InputError(fmt::format("watchdog {} s: must be a number of seconds >= 0 (0: off)", config.watchdog_s));
   session.set_watchdog(config.watchdog_s);
   // The path of each view: those named, else the scene's paths in turn.
   std::vector<const CameraPath*> paths;

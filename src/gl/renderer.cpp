@@ -1,7 +1,6 @@
 #include "occull/gl/renderer.hpp"
 
 #include "gl.hpp"
-#include "occull/error.hpp"
 #include "occull/input_limits.hpp"
 
 #include <glm/gtc/type_ptr.hpp>
@@ -208,11 +207,6 @@ struct DrawCommand {
 
 constexpr GLsizeiptr kBoxCapacity = 1 << 16;
 
-void check_size(const RendererOptions& o) {
-  if (o.width < 1 || o.height < 1 || o.width > limits::viewport_side || o.height > limits::viewport_side)
-    throw InputError(fmt::format("render target {}x{}: each side must be in [1, {}] pixels", o.width, o.height,
-                                 limits::viewport_side));
-}
 // Under --draw multi, material runs shorter than this are drawn one object
 // at a time (see draw_objects).
 constexpr std::size_t kMinMultiDrawRun = 16;
@@ -686,7 +680,8 @@ void Renderer::Impl::upload_dynamic_transforms() {
 }
 
 Renderer::Renderer(const Scene& scene, const RendererOptions& options)
-    : impl_((check_size(options), std::make_unique<Impl>(scene, options))) {
+    : impl_((limits::check_viewport(options.width, options.height, "render target"),
+             std::make_unique<Impl>(scene, options))) {
   impl_->target = query_target(options.query_mode);
   impl_->write_ids = options.write_ids;
   impl_->create_targets();
