@@ -20,6 +20,13 @@ using namespace occull;
 
 namespace {
 
+// `text` as the file NAME in the test's temporary folder; returns its path.
+std::string write_temp(const std::string& name, const std::string& text) {
+  const std::string path = ::testing::TempDir() + name;
+  std::ofstream(path, std::ios::binary) << text;
+  return path;
+}
+
 template <class F>
 std::string error_of(F&& f) {
   try {
@@ -109,33 +116,40 @@ TEST(InputLimits, AMapWhosePatchesTessellatePastTheTriangleLimitIsRefusedBeforeT
 // Found by fuzz_model: assimp's OFF importer allocated the 1.4 billion
 // vertices a 140-byte file's header declared (16 GB) before reading any.
 TEST(InputLimits, AModelHeaderDeclaringMoreItemsThanTheFileHasBytesIsRefusedBeforeAssimp) {
-  const std::string dir = ::testing::TempDir();
-  const auto write = [&](const std::string& name, const std::string& text) {
-    std::ofstream(dir + name, std::ios::binary) << text;
-    return dir + name;
-  };
   // The fuzz input: its first byte picks the extension (3: off), the rest is the file.
   std::ifstream corpus(std::string(OCCULL_SOURCE_DIR) + "/tests/corpus/model/off-declares-billions.off", std::ios::binary);
   const std::string input((std::istreambuf_iterator<char>(corpus)), std::istreambuf_iterator<char>());
   ASSERT_EQ(input.size(), 140u);
-  const std::string fuzzed = write("occull_fuzzed.off", input.substr(1));
+  const std::string fuzzed = write_temp("occull_fuzzed.off", input.substr(1));
   EXPECT_NE(error_of([&] { (void)make_scene("file:" + fuzzed); }).find("its header declares over 10^15 vertices, faces or edges in a file of 139 bytes"),
             std::string::npos);
-  const std::string off = write("occull_many.off", "OFF\n3000000000 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n");
+  const std::string off = write_temp("occull_many.off", "OFF\n3000000000 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n");
   EXPECT_EQ(error_of([&] { (void)make_scene("file:" + off); }),
             off + ": its header declares 3000000000 vertices, faces or edges in a file of 45 bytes: damaged");
-  const std::string ply = write("occull_many.ply",
+  const std::string ply = write_temp("occull_many.ply",
                                 "ply\nformat ascii 1.0\nelement vertex 4000000000\nproperty float x\nproperty float y\n"
                                 "property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n"
                                 "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n");
   EXPECT_NE(error_of([&] { (void)make_scene("file:" + ply); }).find("declares 4000000000 'vertex' elements"),
             std::string::npos);
   // The same files with true counts load.
-  const std::string good_off = write("occull_one.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n");
+  const std::string good_off = write_temp("occull_one.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n");
   EXPECT_EQ(make_scene("file:" + good_off).scene.objects().size(), 1u);
-  const std::string good_ply = write("occull_one.ply",
+  const std::string good_ply = write_temp("occull_one.ply",
                                      "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
                                      "property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n"
                                      "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n");
   EXPECT_EQ(make_scene("file:" + good_ply).scene.objects().size(), 1u);
+}
+
+// Found by fuzz_model: assimp's PLY reader never returned from these.
+TEST(InputLimits, APlyHeaderWithoutEndHeaderOrWithANulByteIsRefusedBeforeAssimp) {
+  const std::string ply_header = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+                                 "property float z\nelement face 1\nproperty list uchar int vertex_indices\n";
+  const std::string no_end = write_temp("occull_no_end.ply", ply_header + "eer\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n");
+  EXPECT_EQ(error_of([&] { (void)make_scene("file:" + no_end); }),
+            no_end + ": a PLY header without end_header in its first 173 bytes: damaged");
+  const std::string nul = write_temp("occull_nul.ply", std::string("ply\nformat ascii 1.0\nelem\0v 0 0 0\nend_header\n", 45));
+  EXPECT_EQ(error_of([&] { (void)make_scene("file:" + nul); }),
+            nul + ": a PLY header with a NUL byte at 25 in its first 45 bytes: damaged");
 }

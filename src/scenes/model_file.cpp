@@ -91,6 +91,14 @@ void check_declared_counts(const std::string& path) {
   std::string first;
   lines >> first;
   if (first == "ply") {  // "element NAME COUNT" lines up to end_header
+    // assimp's PLY reader never returns from a header without end_header
+    // (found by fuzz_model), nor from one with a NUL byte in it.
+    const std::size_t end = head.find("\nend_header");
+    const std::size_t nul = head.find('\0');
+    if (end == std::string::npos || nul < end)
+      throw InputError(fmt::format("{}: a PLY header {} in its first {} bytes: damaged", path,
+                                   nul < end ? fmt::format("with a NUL byte at {}", nul) : "without end_header",
+                                   head.size()));
     std::string line;
     while (std::getline(lines, line) && line.rfind("end_header", 0) != 0) {
       std::istringstream words(line);
