@@ -142,14 +142,33 @@ TEST(InputLimits, AModelHeaderDeclaringMoreItemsThanTheFileHasBytesIsRefusedBefo
   EXPECT_EQ(make_scene("file:" + good_ply).scene.objects().size(), 1u);
 }
 
-// Found by fuzz_model: assimp's PLY reader never returned from these.
-TEST(InputLimits, APlyHeaderWithoutEndHeaderOrWithANulByteIsRefusedBeforeAssimp) {
-  const std::string ply_header = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
-                                 "property float z\nelement face 1\nproperty list uchar int vertex_indices\n";
-  const std::string no_end = write_temp("occull_no_end.ply", ply_header + "eer\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n");
-  EXPECT_EQ(error_of([&] { (void)make_scene("file:" + no_end); }),
-            no_end + ": a PLY header without end_header in its first 173 bytes: damaged");
-  const std::string nul = write_temp("occull_nul.ply", std::string("ply\nformat ascii 1.0\nelem\0v 0 0 0\nend_header\n", 45));
-  EXPECT_EQ(error_of([&] { (void)make_scene("file:" + nul); }),
-            nul + ": a PLY header with a NUL byte at 25 in its first 45 bytes: damaged");
+// Found by fuzz_model: assimp's PLY reader never returned from the first
+// three and aborted the process on the fourth.
+TEST(InputLimits, APlyHeaderOutsideTheFormatIsRefusedBeforeAssimpNamingItsLine) {
+  const std::string header = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+                             "property float z\nelement face 1\nproperty list uchar int vertex_indices\n";
+  const std::string data = "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
+  const auto error = [&](const std::string& name, const std::string& text) {
+    const std::string path = write_temp(name, text);
+    const std::string e = error_of([&] { (void)make_scene("file:" + path); });
+    return e.rfind(path + ": ", 0) == 0 ? e.substr(path.size() + 2) : e;
+  };
+  EXPECT_EQ(error("occull_no_end.ply", header),
+            "line 9 of its PLY header is not there: no end_header line in the first 143 bytes: damaged");
+  EXPECT_EQ(error("occull_nul.ply", std::string("ply\nformat ascii 1.0\nelem\0v 0 0 0\nend_header\n", 45)),
+            "line 3 of its PLY header has a NUL byte: damaged");
+  EXPECT_EQ(error("occull_glued.ply", header + "end_headerrtex 3\n" + data),
+            "line 9 of its PLY header starts with 'end_headerrtex', which no PLY header line does: damaged");
+  EXPECT_EQ(error("occull_type.ply", "ply\nformat ascii 1.0\nelement vertex 1\nproperty floatcii 1.0\nend_header\n0\n"),
+            "line 4 of its PLY header is not 'property TYPE NAME' or 'property list TYPE TYPE NAME' with TYPE one of "
+            "PLY's: damaged");
+  EXPECT_EQ(error("occull_twice.ply", "ply\nformat ascii 1.0\nelement v 1\nproperty float x\nelement v 1\nend_header\n"),
+            "line 5 of its PLY header declares element 'v' again: damaged");
+  // Comments, obj_info, CRLF line ends and the sized type names are PLY.
+  const std::string fine = write_temp("occull_fine.ply",
+                                      "ply\r\nformat ascii 1.0\r\ncomment made by hand\r\nobj_info none\r\n"
+                                      "element vertex 3\r\nproperty float32 x\r\nproperty float32 y\r\n"
+                                      "property float32 z\r\nelement face 1\r\nproperty list uint8 int32 vertex_indices\r\n"
+                                      "end_header\r\n0 0 0\r\n1 0 0\r\n0 1 0\r\n3 0 1 2\r\n");
+  EXPECT_EQ(make_scene("file:" + fine).scene.objects().size(), 1u);
 }
