@@ -143,7 +143,7 @@ TEST(InputLimits, AModelHeaderDeclaringMoreItemsThanTheFileHasBytesIsRefusedBefo
 }
 
 // Found by fuzz_model: assimp's PLY reader never returned from the first
-// three and aborted the process on the fourth.
+// three and the fifth, and aborted the process on the fourth.
 TEST(InputLimits, APlyHeaderOutsideTheFormatIsRefusedBeforeAssimpNamingItsLine) {
   const std::string header = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
                              "property float z\nelement face 1\nproperty list uchar int vertex_indices\n";
@@ -162,6 +162,8 @@ TEST(InputLimits, APlyHeaderOutsideTheFormatIsRefusedBeforeAssimpNamingItsLine) 
   EXPECT_EQ(error("occull_type.ply", "ply\nformat ascii 1.0\nelement vertex 1\nproperty floatcii 1.0\nend_header\n0\n"),
             "line 4 of its PLY header is not 'property TYPE NAME' or 'property list TYPE TYPE NAME' with TYPE one of "
             "PLY's: damaged");
+  EXPECT_EQ(error("occull_magic.PLY", "ply\xff\xff\nformat ascii 1.0\nelement vertex 3\nproperty float3 0 1 2\n"),
+            "line 1 of its PLY header is not 'ply': damaged");
   EXPECT_EQ(error("occull_twice.ply", "ply\nformat ascii 1.0\nelement v 1\nproperty float x\nelement v 1\nend_header\n"),
             "line 5 of its PLY header declares element 'v' again: damaged");
   // Comments, obj_info, CRLF line ends and the sized type names are PLY.

@@ -15,6 +15,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cctype>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -107,7 +108,10 @@ void check_ply_header(const std::string& path, const std::string& head, std::uin
     std::istringstream in(line);
     std::vector<std::string> w;
     for (std::string t; in >> t;) w.push_back(t);
-    if (line_no == 1) continue;  // "ply", seen by the caller
+    if (line_no == 1) {
+      if (w.size() != 1 || w[0] != "ply") damaged(line_no, "is not 'ply'");
+      continue;
+    }
     if (line_no == 2) {
       if (w.size() != 3 || w[0] != "format" ||
           (w[1] != "ascii" && w[1] != "binary_little_endian" && w[1] != "binary_big_endian"))
@@ -153,15 +157,18 @@ void check_declared_counts(const std::string& path) {
   std::istringstream lines(head);
   std::string first;
   lines >> first;
-  if (first == "ply") {
+  std::string extension = std::filesystem::path(path).extension().string();
+  std::transform(extension.begin(), extension.end(), extension.begin(),
+                 [](unsigned char c) { return char(std::tolower(c)); });
+  // assimp reads a file as PLY by its extension, or by its first three bytes.
+  if (extension == ".ply" || head.rfind("ply", 0) == 0) {
     check_ply_header(path, head, bytes);
     return;
   }
-  const std::string extension = std::filesystem::path(path).extension().string();
   const std::size_t off = first.find("OFF");
   const bool keyword = off != std::string::npos && off <= 6 &&
                        first.find_first_not_of("STCN4n") >= off;  // [ST][C][N][4][n]OFF
-  if (!keyword && extension != ".off" && extension != ".OFF") return;
+  if (!keyword && extension != ".off") return;
   // Up to four counts: an optional dimension, vertices, faces, edges.
   std::vector<std::string> tokens;
   if (keyword) {
