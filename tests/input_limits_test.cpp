@@ -8,6 +8,7 @@
 #include "occull/scene.hpp"
 #include "occull/scenes.hpp"
 #include "occull/view.hpp"
+#include "scenes/model_file.hpp"
 #include "test_util.hpp"
 
 #include <gtest/gtest.h>
@@ -173,4 +174,17 @@ TEST(InputLimits, APlyHeaderOutsideTheFormatIsRefusedBeforeAssimpNamingItsLine) 
                                       "property float32 z\r\nelement face 1\r\nproperty list uint8 int32 vertex_indices\r\n"
                                       "end_header\r\n0 0 0\r\n1 0 0\r\n0 1 0\r\n3 0 1 2\r\n");
   EXPECT_EQ(make_scene("file:" + fine).scene.objects().size(), 1u);
+}
+
+// assimp runs in a child process under limits: past one, loading ends in an
+// InputError naming the file, the import and the limit, and this process
+// goes on. (The wall-clock limit is the one a test can pass for certain:
+// the child may reuse heap it inherits without passing its memory limit.
+// tests/child_process_test.cpp ends children every way.)
+TEST(InputLimits, AModelImportPastItsLimitIsAnInputErrorNamingTheFileAndTheLimit) {
+  const std::string obj = std::string(OCCULL_SOURCE_DIR) + "/tests/corpus/model/cube.obj";
+  const ChildLimits no_time{5, 1e-9, 0};
+  EXPECT_EQ(error_of([&] { (void)scenes::load_model_file(obj, 1500, no_time); }),
+            obj + ": assimp's import did not finish within 1e-09 s");
+  EXPECT_GT(scenes::load_model_file(obj).scene.objects().size(), 0u);
 }

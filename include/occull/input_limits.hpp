@@ -27,6 +27,16 @@ inline constexpr std::uint64_t map_bytes = std::uint64_t(256) << 20;
 inline constexpr std::uint64_t archive_bytes = std::uint64_t(4) << 30;
 /// A model file read through assimp (file:MODEL), before assimp allocates.
 inline constexpr std::uint64_t model_bytes = std::uint64_t(512) << 20;
+/// Importing a model (file:MODEL) runs assimp in a child process, so that a
+/// reader that hangs, crashes or allocates without bound on a damaged file
+/// ends that child with an InputError, not the caller's process. The child
+/// may use this much CPU time, seconds (then SIGXCPU)...
+inline constexpr unsigned model_import_cpu_seconds = 120;
+/// ...this much wall-clock time, seconds (then the caller kills it)...
+inline constexpr double model_import_wall_seconds = 300.0;
+/// ...and this much address space beyond what it inherits, bytes (then
+/// allocations fail: std::bad_alloc).
+inline constexpr std::uint64_t model_import_bytes = std::uint64_t(8) << 30;
 /// A text file: a recorded path (.path) or a hardware profile (JSON).
 inline constexpr std::uint64_t text_file_bytes = std::uint64_t(16) << 20;
 /// A viewport's or render target's side, pixels (GL_MAX_RENDERBUFFER_SIZE

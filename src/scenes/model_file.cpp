@@ -15,15 +15,18 @@
 
 #include <algorithm>
 #include <array>
+#include <cstring>
 #include <cctype>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <new>
 #include <optional>
 #include <set>
 #include <sstream>
 #include <string_view>
+#include <type_traits>
 
 namespace occull::scenes {
 namespace {
@@ -184,14 +187,23 @@ void check_declared_counts(const std::string& path) {
   }
 }
 
-}  // namespace
+// What the import child sends back: the materials (at least one), then the
+// triangles in world space, in this process's own layout.
+struct ImportedMaterial {
+  glm::vec4 diffuse{0.7f, 0.7f, 0.7f, 1.0f};
+  float opacity = 1.0f;
+  std::string name = "material";
+};
+static_assert(std::is_trivially_copyable_v<SoupTriangle>);
 
-SceneBundle load_model_file(const std::string& path, std::uint32_t object_triangles) {
-  std::error_code ec;
-  if (!std::filesystem::is_regular_file(path, ec))
-    throw InputError(fmt::format("{}: no such file", path));
-  limits::check_file_size(path, limits::model_bytes, "a model (occull::limits::model_bytes)");
-  check_declared_counts(path);
+template <class T>
+void put(std::string& out, const T& value) {
+  out.append(reinterpret_cast<const char*>(&value), sizeof value);
+}
+
+// Runs in the import child: assimp reads the file, and what occull needs of
+// it is written out as bytes.
+std::string import_with_assimp(const std::string& path) {
   Assimp::Importer importer;
   // ValidateDataStructure runs before the other steps and rejects what an
   // importer made of a malformed file (e.g. faces of an OFF file naming
@@ -200,29 +212,91 @@ SceneBundle load_model_file(const std::string& path, std::uint32_t object_triang
   const aiScene* s = importer.ReadFile(path, aiProcess_ValidateDataStructure | aiProcess_Triangulate |
                                                  aiProcess_GenSmoothNormals | aiProcess_JoinIdenticalVertices |
                                                  aiProcess_SortByPType);
-  if (!s || !s->mRootNode || (s->mFlags & AI_SCENE_FLAGS_INCOMPLETE))
+  if (!s || !s->mRootNode || (s->mFlags & AI_SCENE_FLAGS_INCOMPLETE)) {
+    // assimp catches std::bad_alloc and reports it as text; the child's
+    // limit should be named instead.
+    if (std::string_view(importer.GetErrorString()).find("bad_alloc") != std::string_view::npos) throw std::bad_alloc();
     throw InputError(fmt::format("{}: cannot be read as a model ({})", path, importer.GetErrorString()));
-
+  }
   std::vector<SoupTriangle> tris;
   collect(s, s->mRootNode, glm::mat4(1.0f), tris);
   if (tris.empty()) throw InputError(fmt::format("{}: has no triangles", path));
+
+  std::string out;
+  const std::uint64_t materials = std::max(1u, s->mNumMaterials);
+  put(out, materials);
+  for (unsigned m = 0; m < materials; ++m) {
+    aiColor4D diffuse(0.7f, 0.7f, 0.7f, 1.0f);
+    float opacity = 1.0f;
+    aiString name("material");
+    if (m < s->mNumMaterials) {
+      s->mMaterials[m]->Get(AI_MATKEY_COLOR_DIFFUSE, diffuse);
+      s->mMaterials[m]->Get(AI_MATKEY_OPACITY, opacity);
+      s->mMaterials[m]->Get(AI_MATKEY_NAME, name);
+    }
+    put(out, glm::vec4(diffuse.r, diffuse.g, diffuse.b, diffuse.a));
+    put(out, opacity);
+    put(out, std::uint32_t(name.length));
+    out.append(name.C_Str(), name.length);
+  }
+  put(out, std::uint64_t(tris.size()));
+  out.append(reinterpret_cast<const char*>(tris.data()), tris.size() * sizeof(SoupTriangle));
+  return out;
+}
+
+// Reads import_with_assimp's bytes back. They come from our own code in the
+// child, so a short read is a bug of ours, not damage.
+class ImportReader {
+ public:
+  explicit ImportReader(const std::string& bytes) : bytes_(bytes) {}
+  const char* take(std::uint64_t size) {
+    if (size > bytes_.size() - at_)
+      throw std::logic_error(fmt::format("model import: its result is {} bytes, cut short at {}", bytes_.size(), at_));
+    const char* p = bytes_.data() + at_;
+    at_ += std::size_t(size);
+    return p;
+  }
+  template <class T>
+  T get() {
+    T value;
+    std::memcpy(&value, take(sizeof value), sizeof value);
+    return value;
+  }
+
+ private:
+  const std::string& bytes_;
+  std::size_t at_ = 0;
+};
+
+}  // namespace
+
+SceneBundle load_model_file(const std::string& path, std::uint32_t object_triangles, const ChildLimits& import_limits) {
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec))
+    throw InputError(fmt::format("{}: no such file", path));
+  limits::check_file_size(path, limits::model_bytes, "a model (occull::limits::model_bytes)");
+  check_declared_counts(path);
+  const std::string bytes = run_in_child([&] { return import_with_assimp(path); }, import_limits,
+                                         fmt::format("{}: assimp's import", path));
+  ImportReader in(bytes);
+  std::vector<ImportedMaterial> imported(in.get<std::uint64_t>());
+  for (ImportedMaterial& m : imported) {
+    m.diffuse = in.get<glm::vec4>();
+    m.opacity = in.get<float>();
+    const auto length = in.get<std::uint32_t>();
+    m.name.assign(in.take(length), length);
+  }
+  std::vector<SoupTriangle> tris(in.get<std::uint64_t>());
+  std::memcpy(static_cast<void*>(tris.data()), in.take(tris.size() * sizeof(SoupTriangle)), tris.size() * sizeof(SoupTriangle));
 
   const std::string name = std::filesystem::path(path).filename().string();
   SceneBundle bundle{Scene("file:" + name), {}, Lens{}};
   Scene& scene = bundle.scene;
   std::vector<MaterialId> materials;
-  for (unsigned m = 0; m < std::max(1u, s->mNumMaterials); ++m) {
-    aiColor4D diffuse(0.7f, 0.7f, 0.7f, 1.0f);
-    float opacity = 1.0f;
-    aiString mname("material");
-    if (m < s->mNumMaterials) {
-      s->mMaterials[m]->Get(AI_MATKEY_COLOR_DIFFUSE, diffuse);
-      s->mMaterials[m]->Get(AI_MATKEY_OPACITY, opacity);
-      s->mMaterials[m]->Get(AI_MATKEY_NAME, mname);
-    }
-    const bool translucent = opacity < 0.99f;
-    materials.push_back(scene.add_material({mname.C_Str(), {diffuse.r, diffuse.g, diffuse.b, translucent ? opacity : 1.0f},
-                                            translucent, 0}));
+  for (const ImportedMaterial& m : imported) {
+    const bool translucent = m.opacity < 0.99f;
+    materials.push_back(scene.add_material(
+        {m.name, {m.diffuse.r, m.diffuse.g, m.diffuse.b, translucent ? m.opacity : 1.0f}, translucent, 0}));
   }
   std::vector<std::pair<std::size_t, std::size_t>> groups;
   // Cluster per material, so objects keep their own colour.
