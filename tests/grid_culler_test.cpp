@@ -295,6 +295,52 @@ TEST(QueryBudget, OverTheCapAViewWhoseHiddenCellsComeIntoSightGetsMoreThanOneWho
   EXPECT_THROW(QueryBudget(1, 2), InputError);
 }
 
+TEST(QueryBudget, ByDefaultEachViewIsSureOfAnEvenShareAndWhatOneDoesNotNeedGoesToTheOthers) {
+  QueryBudget lend(100, 2);
+  lend.report(0, 10, 20, 0, 0);     // needs 30 of its 50
+  lend.report(1, 10, 100, 0, 100);  // needs 210
+  lend.split();
+  EXPECT_EQ(lend.allowance(0), 30);
+  EXPECT_EQ(lend.allowance(1), 70);
+  // Both need more than an even share: even shares, whatever their rates.
+  QueryBudget both(100, 2);
+  for (int frame = 0; frame < 10; ++frame) {
+    both.report(0, 10, 100, 50, 100);
+    both.report(1, 10, 100, 0, 100);
+    both.split();
+  }
+  EXPECT_GT(both.reveal_rate(0), 10 * both.reveal_rate(1));
+  EXPECT_EQ(both.allowance(0), 50);
+  EXPECT_EQ(both.allowance(1), 50);
+}
+
+TEST(QueryBudget, RevealRatesFarBelowOnePercentStillDecideTheSplit) {
+  // City street beside turn: the turning view's re-queries find a hidden
+  // cell visible about 4 times in 1000, the street view's about 4 in 10000.
+  QueryBudget b(4000, 2, 0.25);
+  for (int frame = 0; frame < 40; ++frame) {
+    b.report(0, 500, 1000, 4, 600);
+    b.report(1, 500, 2000, frame % 3 == 0 ? 1 : 0, 2000);
+    b.split();
+  }
+  EXPECT_GT(b.reveal_rate(0), 5 * b.reveal_rate(1));
+  EXPECT_EQ(b.allowance(0), 500 + 1600) << "view 0 gets all it asks for";
+  EXPECT_EQ(b.allowance(0) + b.allowance(1), 4000);
+}
+
+TEST(QueryBudget, AViewWhoseDemandComesInBurstsKeepsAnAllowanceForItsRecentPeak) {
+  // Hidden answers expire together, so a view asks for many re-queries every
+  // few frames and few in between; last frame's demand would cap the burst.
+  QueryBudget b(4000, 2, 0.25);
+  for (int frame = 0; frame < 40; ++frame) {
+    const bool burst = frame % 4 == 0;
+    b.report(0, 300, burst ? 1700 : 100, burst ? 7 : 0, 0);
+    b.report(1, 500, 2000, 1, 3000);
+    b.split();
+    EXPECT_GE(b.allowance(0), 2000) << "after frame " << frame;
+  }
+}
+
 TEST(GridViews, ViewsShareOneGridAndTheViewWhoseHiddenCellsComeIntoSightGetsTheLargerShare) {
   Stage s;
   Options o;
@@ -302,6 +348,7 @@ TEST(GridViews, ViewsShareOneGridAndTheViewWhoseHiddenCellsComeIntoSightGetsTheL
   o.set("grid.cap=6");
   o.set("grid.vis_duration=1");
   o.set("grid.split=reveal");
+  o.set("grid.split_floor=0.25");  // both views ask for more than half the cap: let the rate split most of it
   // Both views look past the wall. In view 0 the wall comes and goes (every
   // other frame everything is visible), so re-queries of its hidden cells
   // find them visible again; in view 1 the wall stands.

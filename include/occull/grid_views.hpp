@@ -29,50 +29,59 @@ namespace occull {
 /// are the ones the split decides. A view turning fast or moving past
 /// occluders reveals many; one standing behind a wall reveals few.
 ///
-/// Measured (city, street beside turn, 640x180, 150 frames at 30 fps): with
-/// the default durations Policy::reveal popped more than Policy::even (35 vs
-/// 23 missed object-frames, same frame time), because allowances close to
-/// the demands cap both views in most frames, and capped frames lengthen
-/// the durations of hidden answers (grid.invis_growth); with
-/// grid.invis_growth=0 it popped less (3 vs 11). Two variants did worse
-/// and were dropped: all of the rest to the view with the higher rate (42
-/// missed), and growing durations only when the views' total demand
-/// exceeded the total rather than at each view's allowance (58 vs 23 for
-/// even, longest miss 5 frames, 16 % more queries). The misses are all in
-/// the turning view (path turn); a guess not yet checked: cells at the
-/// frustum's sides, hidden only because their visible part was outside it,
-/// whose answers the cap keeps stale while the view turns, so ordering a
-/// view's re-queries within its allowance may matter more than the split.
-/// Policy::even is therefore GridViews' default.
+/// Estimating that rate: reveals are rare (in city street beside turn, about
+/// 4 re-queries in 1000 of the turning view, 4 in 10000 of the street
+/// view), so the counts, not per-frame shares, are smoothed (decayed by
+/// 9/10 per frame) and the rate is (revealed + 0.01) / (re-queries + 1):
+/// rates far below 1 % stay apart. A view's demand for re-queries is the
+/// peak of its last 8 frames, not its last frame's: hidden answers expire
+/// together, so a view asks for many every few frames and few in between,
+/// and last frame's demand would cap each burst.
 ///
-/// Policy, once per frame (split()), from each view's last report:
-///  - forced: the queries of drawn cells, which run past the cap anyway;
-///  - optional demand: hidden re-queries issued plus those deferred;
-///  - rate: the reveal rate, smoothed over frames (exponential, weight 1/4
-///    for the newest), at least 1 %;
+/// Policy, once per frame (split()), from each view's reports:
+///  - forced: last frame's queries of drawn cells, which run past the cap anyway;
+///  - optional demand: hidden re-queries issued plus those deferred, the
+///    peak over the last 8 frames;
 ///  - if all demands fit in the total, each view gets its demand and the
 ///    slack is shared evenly;
 ///  - otherwise the total less the forced queries is split: each view first
-///    gets min(optional demand, floor · that / views), the rest goes in
-///    proportion to remaining optional demand × rate, capped at each one's
-///    remaining demand, leftovers passed on. A view's allowance is its
-///    forced queries plus its share; at least 1.
+///    gets min(optional demand, floor · that / views) — with floor 1 (the
+///    default), an even split of it, capped at what the view asks — and
+///    the rest goes in proportion to remaining optional demand × rate,
+///    capped at each one's remaining demand, leftovers passed on. So a
+///    view that needs less than an even share lends the remainder to the
+///    views whose re-queries reveal most. A view's allowance is its forced
+///    queries plus its share; at least 1.
 /// The allowance counts every query of the view (as grid.cap does), so it
 /// is exact when the forced ones are as many as in the last frame.
 /// Policy::even: total / views each, whatever was reported.
+///
+/// Measured (2 views at 640x180, 150 frames at 30 fps, llvmpipe; missed
+/// object-frames, longest miss in frames), reveal with floor 1 against even:
+/// city street beside turn 17 vs 23 (2 vs 2); city:blocks=20 street beside
+/// turn 242 vs 384 (18 vs 22); track lap beside overview 269 vs 322 (18 vs
+/// 20); frame time within the noise of one run. Measured and dropped:
+/// floor 0.25 with the old rate (per-frame shares, smoothed, at least 1 %,
+/// which flattened both views' rates to 1 %) and last frame's demand
+/// popped more than even (35 vs 23); floor 0.5 popped less on two scenes
+/// and as much on track (319 vs 322) while its low-rate view popped more
+/// (166 vs 84); all of the rest to the view with the higher rate (42 vs 23);
+/// growing durations only on a total shortage (58 vs 23). Policy::reveal
+/// with floor 1 is therefore GridViews' default.
 class QueryBudget {
  public:
   enum class Policy { reveal, even };
 
   /// Preconditions: views >= 1, total >= views, 0 <= floor <= 1.
-  QueryBudget(int total, int views, double floor = 0.25, Policy policy = Policy::reveal);
+  QueryBudget(int total, int views, double floor = 1.0, Policy policy = Policy::reveal);
 
   [[nodiscard]] int views() const noexcept { return int(allowance_.size()); }
   [[nodiscard]] int total() const noexcept { return total_; }
   /// This frame's cap of view `view` (0-based), >= 1. Before the first
   /// split(): an even share.
   [[nodiscard]] int allowance(int view) const { return allowance_.at(std::size_t(view)); }
-  /// The smoothed share of the view's hidden re-queries that found the cell visible.
+  /// The smoothed share of the view's hidden re-queries that found the cell
+  /// visible and drew something new (see above), in (0, 1].
   [[nodiscard]] double reveal_rate(int view) const { return rate_.at(std::size_t(view)); }
 
   /// What one frame of view `view` asked: `forced` queries of cells it drew,
@@ -90,8 +99,13 @@ class QueryBudget {
   double floor_;
   Policy policy_;
   std::vector<int> allowance_;
+  static constexpr double kPriorReveals = 0.01;  // per query, as if one query had been seen
   std::vector<double> rate_;
-  std::vector<std::uint64_t> forced_, optional_;
+  std::vector<double> revealed_, rechecked_;     // per view, decayed by 3/4 per report
+  static constexpr std::size_t kDemandWindow = 8;  // frames of reports a view's optional demand is the peak of
+  std::vector<std::uint64_t> reports_;             // per view
+  std::vector<std::uint64_t> forced_;              // per view, its last report
+  std::vector<std::uint64_t> optional_;            // per view, its last kDemandWindow reports
 };
 
 /// One grid culler per view over one shared grid and query budget.
@@ -99,7 +113,7 @@ class GridViews {
  public:
   /// A `grid` culler per view, with `options` (grid.*; grid.cap is the
   /// total of all views, grid.split the QueryBudget's policy, reveal or
-  /// even, grid.split_floor its floor).
+  /// even (default reveal), grid.split_floor its floor (default 1)).
   /// Preconditions: index.scene outlives this object; 1 <= views <= 16.
   /// Throws InputError for a bad option.
   GridViews(const SceneIndex& index, int views, const Options& options = {});

@@ -96,8 +96,8 @@ const std::vector<Entry>& registry() {
          {"conditional", "wait", "pre-pass of a cell queried this frame under conditional rendering on its query: wait (the device waits for the result), no_wait (draws while it is unknown) or off"},
          {"threshold", "0", "a cell is visible when more samples (pixels) pass"},
          {"seed", "1", "random seed of the answers' extra duration when capped"},
-         {"split", "even", "split screen (bench --views): how the views share the cap; even: cap / views each; reveal: what the queries of drawn cells leave goes by demand x share of the view's deferred hidden cells whose re-query found them visible (measured: less popping than even only with invis_growth=0)"},
-         {"split_floor", "0.25", "with split=reveal: share of an even split of what the queries of drawn cells leave each view is sure of"}}},
+         {"split", "reveal", "split screen (bench --views): how the views share the cap; reveal: an even split of what the queries of drawn cells leave, capped at each view's recent peak demand, and what a view does not need lent in proportion to demand x share of its re-queries of hidden cells that found them visible (measured: less popping than even); even: cap / views each"},
+         {"split_floor", "1", "with split=reveal: share of an even split of what the queries of drawn cells leave each view is sure of (below 1, more goes by reveal rate)"}}},
        &detail::make_grid},
       {{"auto",
         "adaptive: runs the cheapest of chcpp, vfc and nohc for this view, learnt from the measured frame times, "

@@ -316,8 +316,10 @@ std::unique_ptr<Culler> make_grid(const SceneIndex& index, const Options& o) {
 namespace occull {
 
 QueryBudget::QueryBudget(int total, int views, double floor, Policy policy)
-    : total_(total), floor_(floor), policy_(policy), allowance_(std::size_t(views)), rate_(std::size_t(views), 1.0),
-      forced_(std::size_t(views), 0), optional_(std::size_t(views), 0) {
+    : total_(total), floor_(floor), policy_(policy), allowance_(std::size_t(views)), rate_(std::size_t(views), kPriorReveals),
+      revealed_(std::size_t(views), 0.0), rechecked_(std::size_t(views), 0.0),
+      reports_(std::size_t(views), 0), forced_(std::size_t(views), 0),
+      optional_(std::size_t(views) * kDemandWindow, 0) {
   if (views < 1 || total < views || !(floor >= 0.0 && floor <= 1.0))
     throw InputError(fmt::format("query budget: {} queries for {} views (floor {}) cannot be split", total, views,
                                  floor));
@@ -328,24 +330,33 @@ void QueryBudget::report(int view, std::uint64_t forced, std::uint64_t rechecked
                          std::uint64_t deferred) {
   const std::size_t k = std::size_t(view);
   forced_.at(k) = forced;
-  optional_.at(k) = rechecked + deferred;
-  if (rechecked == 0) return;
-  const double share = double(std::min(revealed, rechecked)) / double(rechecked);
-  rate_[k] = std::max(0.01, 0.75 * rate_[k] + 0.25 * share);
+  optional_[k * kDemandWindow + reports_[k]++ % kDemandWindow] = rechecked + deferred;
+  // Counts, not shares, are smoothed: a frame of 2000 re-queries weighs
+  // more than one of 20, and rates far below 1 % stay apart (one view's
+  // re-queries may reveal ten times as often as another's).
+  revealed_[k] = 0.9 * revealed_[k] + double(std::min(revealed, rechecked));
+  rechecked_[k] = 0.9 * rechecked_[k] + double(rechecked);
+  rate_[k] = (revealed_[k] + kPriorReveals) / (rechecked_[k] + 1.0);
 }
 
 void QueryBudget::split() {
   if (policy_ == Policy::even) return;  // the constructor's even shares
   const std::size_t n = allowance_.size();
+  // Each view's demand: the queries of the cells it drew last frame, and
+  // the most re-queries of hidden cells it asked for in one of its recent
+  // frames (hidden answers expire together, so that demand comes in bursts).
+  std::vector<std::uint64_t> forced_of(forced_), optional_of(n, 0);
   std::uint64_t wanted = 0, forced = 0;
   for (std::size_t k = 0; k < n; ++k) {
-    wanted += forced_[k] + optional_[k];
-    forced += forced_[k];
+    for (std::size_t i = k * kDemandWindow; i < (k + 1) * kDemandWindow; ++i)
+      optional_of[k] = std::max(optional_of[k], optional_[i]);
+    wanted += forced_of[k] + optional_of[k];
+    forced += forced_of[k];
   }
   if (wanted <= std::uint64_t(total_)) {
     // Everyone gets what it asked for; the slack is shared evenly.
     const std::uint64_t slack = (std::uint64_t(total_) - wanted) / n;
-    for (std::size_t k = 0; k < n; ++k) allowance_[k] = int(forced_[k] + optional_[k] + slack);
+    for (std::size_t k = 0; k < n; ++k) allowance_[k] = int(forced_of[k] + optional_of[k] + slack);
   } else {
     // What the forced queries leave: a floor each, then the rest by
     // remaining optional demand x reveal rate.
@@ -354,8 +365,8 @@ void QueryBudget::split() {
     std::vector<std::uint64_t> grant(n), rest(n);
     std::uint64_t left = free;
     for (std::size_t k = 0; k < n; ++k) {
-      grant[k] = std::min(optional_[k], floor_each);
-      rest[k] = optional_[k] - grant[k];
+      grant[k] = std::min(optional_of[k], floor_each);
+      rest[k] = optional_of[k] - grant[k];
       left -= grant[k];
     }
     // Proportional shares; a view that needs less than its share passes the remainder on.
@@ -376,7 +387,7 @@ void QueryBudget::split() {
       left -= given;
       if (given == 0) break;
     }
-    for (std::size_t k = 0; k < n; ++k) allowance_[k] = int(forced_[k] + grant[k]);
+    for (std::size_t k = 0; k < n; ++k) allowance_[k] = int(forced_of[k] + grant[k]);
   }
   for (int& a : allowance_) a = std::max(a, 1);
 }
@@ -386,8 +397,8 @@ GridViews::GridViews(const SceneIndex& index, int views, const Options& options)
   check_options(options);
   const detail::GridConfig c = detail::grid_config(options);
   grid_ = std::make_shared<UniformGrid>(UniformGrid::of_scene(index.scene, c.cell));
-  const double floor = options.get_double("grid.split_floor", 0.25, 0.0, 1.0);
-  const bool even = options.get_choice("grid.split", "even", {"even", "reveal"}) == "even";
+  const double floor = options.get_double("grid.split_floor", 1.0, 0.0, 1.0);
+  const bool even = options.get_choice("grid.split", "reveal", {"reveal", "even"}) == "even";
   budget_ = std::make_shared<QueryBudget>(std::max(c.cap, views), views, floor,
                                           even ? QueryBudget::Policy::even : QueryBudget::Policy::reveal);
   for (int k = 0; k < views; ++k) {
