@@ -49,6 +49,15 @@ class Bvh {
   /// Builds the hierarchy over every object of `scene` at its current
   /// bounds. An empty scene gives a single empty leaf.
   [[nodiscard]] static Bvh build(const Scene& scene, const BvhOptions& options = {});
+  /// Builds over bare boxes: object i has box `bounds[i]` and `triangles[i]`
+  /// triangles, and every object is static (a tile's local objects, built
+  /// once and instanced). Precondition: both spans have the same size.
+  [[nodiscard]] static Bvh build(std::span<const Aabb> bounds, std::span<const std::uint32_t> triangles,
+                                 const BvhOptions& options = {});
+  /// A copy moved by `offset` (scene units) whose leaves name object
+  /// `first_object + i` for object i of this one: the BVH of one instance
+  /// of a tile whose objects occupy consecutive ids from `first_object`.
+  [[nodiscard]] Bvh instance(const glm::vec3& offset, ObjectId first_object) const;
 
   /// Recomputes node bounds from the objects' current bounds (after
   /// Scene::update). Only the dynamic subtree and its ancestors are touched

@@ -5,6 +5,7 @@
 #include "occull/bvh.hpp"
 #include "occull/scene.hpp"
 #include "occull/stats.hpp"
+#include "occull/tiles.hpp"
 #include "occull/view.hpp"
 
 #include <map>
@@ -23,6 +24,9 @@ namespace occull {
 struct SceneIndex {
   const Scene& scene;
   const Bvh& bvh;
+  /// The tiled world whose window `scene` holds, or null: the tile
+  /// algorithms (tilevfc, pertile, tiles) need one; `bvh` means nothing then.
+  const TiledWorld* world = nullptr;
 };
 
 /// Algorithm options as "algorithm.key" -> "value" strings, e.g.
@@ -77,6 +81,12 @@ struct OptionInfo {
   std::string help;
 };
 
+/// What kind of scene an algorithm runs on.
+enum class SceneKind : std::uint8_t {
+  bvh,    ///< one scene with its BVH (every scene but a tiled world)
+  tiled,  ///< a tiled world only (SceneIndex::world)
+  any,    ///< either
+};
 struct AlgorithmInfo {
   std::string name;
   std::string summary;
@@ -85,10 +95,20 @@ struct AlgorithmInfo {
   /// Needs each frame's ground truth, so only the harness can run it
   /// (`oracle`); make_culler() refuses it.
   bool harness_only = false;
+  SceneKind scenes = SceneKind::bvh;
 };
 
 /// Every algorithm make_culler() knows, in presentation order.
 [[nodiscard]] std::span<const AlgorithmInfo> algorithms();
+/// Whether `info` runs on a tiled world (`tiled`) or on a scene with a BVH.
+[[nodiscard]] bool runs_on(const AlgorithmInfo& info, bool tiled) noexcept;
+/// What `occull bench` runs when no algorithm is named: every algorithm
+/// that runs on the scene's kind, in presentation order; on a tiled world
+/// also `tiles:local=none` (seed 004's "tile query alone").
+[[nodiscard]] std::vector<std::string> default_algorithms(bool tiled);
+/// The frustum-culling baseline the harness's "vs vfc" ratios divide by:
+/// `vfc`, or `tilevfc` on a tiled world.
+[[nodiscard]] std::string_view vfc_baseline(bool tiled) noexcept;
 /// Comma-separated list of algorithm names (for error messages and help).
 [[nodiscard]] std::string algorithm_names();
 /// The named algorithm. Throws InputError listing the valid names.
@@ -116,7 +136,9 @@ struct AlgorithmSpec {
 void check_options(const Options& options);
 
 /// Makes the named culler. Throws InputError for an unknown name (listing
-/// the valid ones) or an unknown / invalid option of that algorithm.
+/// the valid ones), an unknown / invalid option of that algorithm, or a
+/// scene of a kind it does not run on (AlgorithmInfo::scenes; the message
+/// lists those that do).
 [[nodiscard]] std::unique_ptr<Culler> make_culler(std::string_view name, const SceneIndex& index,
                                                   const Options& options = {});
 

@@ -219,7 +219,7 @@ class Session {
   [[nodiscard]] View view_at(const CameraPath& path, int k, int frames) const;
 
   [[nodiscard]] const SceneBundle& bundle() const noexcept { return bundle_; }
-  [[nodiscard]] SceneIndex index() const noexcept { return {bundle_.scene, bvh_}; }
+  [[nodiscard]] SceneIndex index() const noexcept { return {bundle_.scene, bvh_, bundle_.world.get()}; }
   [[nodiscard]] gl::Renderer& renderer() noexcept { return *renderer_; }
   [[nodiscard]] const gl::DeviceInfo& device() const noexcept { return device_; }
   [[nodiscard]] double scene_build_ms() const noexcept { return scene_build_ms_; }

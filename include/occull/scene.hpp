@@ -98,6 +98,18 @@ class Scene {
   ObjectId add_dynamic_object(MeshId mesh, MaterialId material, Motion motion,
                               OccluderClass occluder, const glm::mat4& local = glm::mat4(1.0f));
 
+  /// Makes static object `id` another object in place: its mesh, material,
+  /// transform and class (a tiled world reuses the ids of a tile that left
+  /// its window for the one that entered). Bounds and triangles follow.
+  /// Records `id` in moved_objects(). Preconditions: `id` exists and is
+  /// static; mesh and material exist.
+  void place_object(ObjectId id, MeshId mesh, MaterialId material, const glm::mat4& transform,
+                    OccluderClass occluder);
+  /// Objects placed since the last clear_moved(), in placing order (an id
+  /// may appear more than once). A renderer that keeps transforms on the
+  /// device re-uploads these.
+  [[nodiscard]] std::span<const ObjectId> moved_objects() const noexcept { return moved_; }
+  void clear_moved() noexcept { moved_.clear(); }
   /// Moves every dynamic object to where it is at `time_s` and updates its
   /// bounds. Deterministic: the same time gives the same transforms.
   void update(double time_s);
@@ -129,6 +141,7 @@ class Scene {
   std::vector<Motion> motions_;
   std::vector<glm::mat4> dynamic_local_;  // per motion: local transform
   std::vector<ObjectId> dynamic_;
+  std::vector<ObjectId> moved_;
   std::vector<Aabb> mesh_bounds_;
   std::vector<double> mesh_area_;
   std::uint64_t mesh_triangles_ = 0;  // sum over meshes_, against caps_

@@ -5,6 +5,8 @@
 #pragma once
 
 #include "occull/scene.hpp"
+#include "occull/tiles.hpp"
+#include <memory>
 #include "occull/view.hpp"
 
 #include <span>
@@ -38,6 +40,10 @@ struct SceneBundle {
   Scene scene;
   std::vector<CameraPath> paths;  ///< default first
   Lens lens;
+  /// Set for a tiled world (tiles_city, ...): the scene holds its window of
+  /// objects, and the owner calls world->follow(scene, eye) before each
+  /// frame it renders (occull/tiles.hpp).
+  std::shared_ptr<TiledWorld> world;
 
   /// The named path. Throws InputError listing the valid names.
   [[nodiscard]] const CameraPath& path(std::string_view name) const;

@@ -35,6 +35,15 @@ struct FrameStats {
   double result_age = 0.0;       ///< mean frames since the query behind each answer used was issued
   std::uint64_t revealed = 0;    ///< hidden cells whose query found them visible and were drawn in its frame
 
+  // Tiled worlds (tilevfc, pertile, tiles; seed 004).
+  std::uint64_t tiles_rendered = 0;      ///< tile instances drawn (culled inside by their own culler, if any)
+  std::uint64_t tile_queries = 0;        ///< queries of the common box at a tile (tiles)
+  std::uint64_t tile_postponed = 0;      ///< tiles drawn on last frame's visibility while their query was pending (Algorithm 3)
+  std::uint64_t tile_prediction_failures = 0;  ///< postponed queries still without a result at the frame's end (Algorithm 4)
+  std::uint64_t tiles_instantiated = 0;  ///< tile instances (BVH instance, CHC++ context) created in the frame
+  std::uint64_t tiles_evicted = 0;       ///< ... and freed, unused for the eviction time
+  std::uint64_t tile_cache = 0;          ///< tile instances held after the frame
+  double instantiate_ms = 0.0;           ///< time spent creating tile instances in the frame
   // Backend counters (differences over the frame).
   std::uint64_t queries = 0;
   std::uint64_t query_boxes = 0;

@@ -174,6 +174,33 @@ Bvh Bvh::build(const Scene& scene, const BvhOptions& options) {
   return bvh;
 }
 
+Bvh Bvh::build(std::span<const Aabb> bounds, std::span<const std::uint32_t> triangles,
+               const BvhOptions& options) {
+  assert(options.max_leaf_objects >= 1 && bounds.size() == triangles.size());
+  Bvh bvh;
+  std::vector<BuildItem> items;
+  items.reserve(bounds.size());
+  for (ObjectId id = 0; id < bounds.size(); ++id)
+    items.push_back({bounds[id], bounds[id].center(), id, triangles[id]});
+  bvh.nodes_.reserve(2 * items.size() + 1);
+  Builder builder(items, options, bvh.nodes_);
+  builder.build(0, items.size(), kNoNode, 0);
+  bvh.objects_.reserve(items.size());
+  for (const auto& it : items) bvh.objects_.push_back(it.id);
+  return bvh;
+}
+
+Bvh Bvh::instance(const glm::vec3& offset, ObjectId first_object) const {
+  Bvh copy = *this;
+  for (BvhNode& n : copy.nodes_) {
+    if (n.bounds.empty()) continue;
+    n.bounds.min += offset;
+    n.bounds.max += offset;
+  }
+  for (ObjectId& id : copy.objects_) id += first_object;
+  return copy;
+}
+
 void Bvh::refit(const Scene& scene) {
   const auto objects = scene.objects();
   const auto refit_node = [&](NodeId n) {

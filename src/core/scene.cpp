@@ -99,6 +99,20 @@ ObjectId Scene::add_dynamic_object(MeshId mesh, MaterialId material, Motion moti
   return id;
 }
 
+void Scene::place_object(ObjectId id, MeshId mesh, MaterialId material, const glm::mat4& transform,
+                         OccluderClass occluder) {
+  assert(id < objects_.size() && !objects_[id].dynamic());
+  assert(mesh < meshes_.size() && material < materials_.size());
+  Object& o = objects_[id];
+  o.mesh = mesh;
+  o.material = material;
+  o.transform = transform;
+  o.bounds = transform_box(mesh_bounds_[mesh], transform);
+  o.triangles = std::uint32_t(meshes_[mesh].triangle_count());
+  o.occluder = occluder;
+  moved_.push_back(id);
+}
+
 void Scene::update(double time_s) {
   for (ObjectId id : dynamic_) {
     Object& o = objects_[id];

@@ -22,7 +22,7 @@ struct Entry {
 
 const std::vector<Entry>& registry() {
   static const std::vector<Entry> entries = {
-      {{"none", "render every object (reference cost of no culling)", true, {}},
+      {{"none", "render every object (reference cost of no culling)", true, {}, false, SceneKind::any},
        &detail::make_none},
       {{"vfc", "hierarchical view-frustum culling over the BVH, front to back", true, {}},
        &detail::make_vfc},
@@ -108,9 +108,27 @@ const std::vector<Entry>& registry() {
          {"period", "50", "frames between tries of a challenger (doubled after each lost try, up to 16x)"},
          {"margin", "0.15", "a challenger must be this much cheaper to take over (frame times of one culler vary more than 5 % between frames)"}}},
        &detail::make_auto},
+      {{"tilevfc", "tiled worlds: view-frustum culling over the BVH of every tile instance in the frustum, nearest tile first (seed 004's baseline)",
+        true,
+        {{"evict", "60", "frames a tile instance may go unused before its BVH instance is freed"}},
+        false, SceneKind::tiled},
+       &detail::make_tilevfc},
+      {{"pertile", "tiled worlds: every tile instance in the frustum culled by its own CHC++ context, nearest first, no tile queries (seed 004)",
+        true,
+        {{"evict", "60", "frames a tile instance may go unused before its BVH instance and CHC++ context are freed"}},
+        false, SceneKind::tiled},
+       &detail::make_pertile},
+      {{"tiles", "tiled worlds: visibility propagated tile to tile by queries of the common box, front to back, "
+                 "with temporal prediction; each visible tile culled by its own CHC++ (seed 004, Algorithms 1-4)",
+        true,
+        {{"local", "chcpp", "culling inside a visible tile: chcpp (its own CHC++ context) or none (draw the whole tile)"},
+         {"evict", "60", "frames a tile instance may go unused before its BVH instance and CHC++ context are freed"},
+         {"neighbors", "8", "neighbours a visible tile queries: 4 (edges) or 8 (edges and corners)"}},
+        false, SceneKind::tiled},
+       &detail::make_tiles},
       {{"oracle",
         "renders exactly the ground-truth visible set, no queries: the lower bound (occull bench only)",
-        true, {}, true},
+        true, {}, true, SceneKind::any},
        nullptr},
   };
   return entries;
@@ -229,6 +247,22 @@ void check_options(const Options& options) {
   }
 }
 
+bool runs_on(const AlgorithmInfo& info, bool tiled) noexcept {
+  return info.scenes == SceneKind::any || (info.scenes == SceneKind::tiled) == tiled;
+}
+
+std::vector<std::string> default_algorithms(bool tiled) {
+  std::vector<std::string> names;
+  for (const Entry& e : registry()) {
+    if (!runs_on(e.info, tiled)) continue;
+    names.push_back(e.info.name);
+    if (e.info.name == "tiles") names.push_back("tiles:local=none");
+  }
+  return names;
+}
+
+std::string_view vfc_baseline(bool tiled) noexcept { return tiled ? "tilevfc" : "vfc"; }
+
 const AlgorithmInfo& find_algorithm(std::string_view name) {
   for (const AlgorithmInfo& a : algorithms())
     if (a.name == name) return a;
@@ -274,6 +308,15 @@ std::unique_ptr<Culler> make_culler(std::string_view name, const SceneIndex& ind
     throw InputError(fmt::format("{} needs each frame's ground truth: it runs only in the harness "
                                  "(occull bench)",
                                  entry->info.name));
+  const bool tiled = index.world != nullptr;
+  if (!runs_on(entry->info, tiled)) {
+    std::string fits;
+    for (const Entry& e : registry())
+      if (runs_on(e.info, tiled)) fits += (fits.empty() ? "" : ", ") + e.info.name;
+    throw InputError(fmt::format("{} does not run on {}; algorithms that do: {}", entry->info.name,
+                                 tiled ? "a tiled world (it has no global BVH)" : "a scene that is not a tiled world",
+                                 fits));
+  }
   return entry->make(index, options);
 }
 

@@ -16,5 +16,8 @@ std::unique_ptr<Culler> make_chcpp(const SceneIndex& index, const Options& optio
 std::unique_ptr<Culler> make_nohc(const SceneIndex& index, const Options& options);
 std::unique_ptr<Culler> make_grid(const SceneIndex& index, const Options& options);
 std::unique_ptr<Culler> make_auto(const SceneIndex& index, const Options& options);
+std::unique_ptr<Culler> make_tilevfc(const SceneIndex& index, const Options& options);
+std::unique_ptr<Culler> make_pertile(const SceneIndex& index, const Options& options);
+std::unique_ptr<Culler> make_tiles(const SceneIndex& index, const Options& options);
 
 }  // namespace occull::detail

@@ -94,8 +94,16 @@ Session::Session(std::string_view scene_spec, const gl::RendererOptions& rendere
     : scene_spec_(scene_spec), bundle_(timed_make_scene(scene_spec, scene_build_ms_)),
       context_options_(context_options) {
   const auto t0 = Clock::now();
-  bvh_ = Bvh::build(bundle_.scene, bvh_options);
+  // A tiled world has no global hierarchy: its cullers keep one BVH
+  // instance per tile (occull/tiles.hpp).
+  bvh_ = bundle_.world ? Bvh::build(std::span<const Aabb>{}, std::span<const std::uint32_t>{})
+                       : Bvh::build(bundle_.scene, bvh_options);
   bvh_build_ms_ = ms_between(t0, Clock::now());
+  if (bundle_.world && float(renderer_options.width) > TiledWorld::kMaxAspect * float(renderer_options.height))
+    throw InputError(fmt::format("{}: a {}x{} viewport is wider than {}:1, the widest a tiled world's window of "
+                                 "placed tiles covers (occull::TiledWorld::kMaxAspect)",
+                                 scene_spec, renderer_options.width, renderer_options.height,
+                                 TiledWorld::kMaxAspect));
   context_ = gl::Context::create(context_options_);
   device_ = context_->info();
   renderer_options_ = renderer_options;
@@ -156,9 +164,10 @@ View Session::view_at(const CameraPath& path, int k, int frames) const {
 FrameStats Session::run_frame(Culler& culler, const View& view, double time_s) {
   const auto step = watchdog_->step(fmt::format("a culler's frame at {:.3f} s of the path", time_s));
   bundle_.scene.update(time_s);
+  if (bundle_.world) bundle_.world->follow(bundle_.scene, view.eye);
   const ProcessUsage u0 = process_usage();
   const auto t0 = Clock::now();
-  bvh_.refit(bundle_.scene);
+  if (!bundle_.world) bvh_.refit(bundle_.scene);
   renderer_->begin_frame(view);
   Backend& backend = this->backend();
   const BackendStats before = backend.stats();
@@ -206,6 +215,7 @@ std::vector<FrameTruth> Session::ground_truth(const CameraPath& path, int frames
   for (int k = 0; k < frames; ++k) {
     bundle_.scene.update(frame_time(path, k, frames));
     const View view = view_at(path, k, frames);
+    if (bundle_.world) bundle_.world->follow(bundle_.scene, view.eye);
     const detail::FrameLabel where{scene_spec_, path.name(), k};
     const auto step = watchdog_->step(fmt::format("ground-truth frame {} of path {}", k, path.name()));
     in_frustum.clear();
@@ -435,7 +445,10 @@ std::vector<AlgorithmSummary> summarize_runs(std::span<const AlgorithmRun> runs)
         const auto it = mean_ms.find({r.repeat, base + view});
         if (it != mean_ms.end() && it->second > 0) per_repeat[key].push_back(s.mean / it->second);
       };
-      ratio("vfc", "ratio_to_vfc");
+      // The frustum-culling baseline: vfc, or tilevfc on a tiled world (a
+      // run has one or the other: each refuses the other's scenes).
+      const bool tiled_run = mean_ms.count({r.repeat, std::string(vfc_baseline(true)) + view}) > 0;
+      ratio(std::string(vfc_baseline(tiled_run)).c_str(), "ratio_to_vfc");
       ratio("oracle", "ratio_to_oracle");
       a.missed_objects = std::max(a.missed_objects, missed);
       a.truth_object_frames = std::max(a.truth_object_frames, truth);
@@ -609,13 +622,14 @@ BenchResult run_bench(const BenchConfig& config, const ProgressFn& progress) {
   if (config.warmup < 0) throw InputError(fmt::format("--warmup {}: must not be negative", config.warmup));
   if (config.repeat < 1) throw InputError(fmt::format("--repeat {}: must be at least 1", config.repeat));
   std::vector<std::string> names = config.algorithms;
-  if (names.empty())
-    for (const auto& a : algorithms()) names.push_back(a.name);
+  const auto check_names = [&] {
+    for (const auto& n : names) {
+      if (find_algorithm(parse_algorithm_spec(n).name).harness_only && !config.verify)
+        throw InputError(fmt::format("{} needs ground truth: drop it or turn verification on", n));
+    }
+  };
   // Validate names and options before the (slow) scene set-up.
-  for (const auto& n : names) {
-    if (find_algorithm(parse_algorithm_spec(n).name).harness_only && !config.verify)
-      throw InputError(fmt::format("{} needs ground truth: drop it or turn verification on", n));
-  }
+  check_names();
   check_options(config.options);
 
   if (config.views < 1 || config.views > 8)
@@ -646,6 +660,10 @@ BenchResult run_bench(const BenchConfig& config, const ProgressFn& progress) {
   session.set_sampling(config.sampling);
   session.set_stall_guard(config.stall_guard_ms);
   session.set_watchdog(config.watchdog_s);
+  if (names.empty()) {  // every algorithm that runs on this kind of scene
+    names = default_algorithms(session.bundle().world != nullptr);
+    check_names();
+  }
   // The path of each view: those named, else the scene's paths in turn.
   std::vector<const CameraPath*> paths;
   for (int k = 0; k < config.views; ++k) {

@@ -120,6 +120,8 @@ std::size_t check_truth_probes(const FrameLabel& where, const Scene& scene, cons
   // the eye change depth fast across a pixel).
   constexpr double kDepthSlack = 1e-6;
   constexpr double kSnapPixels = 0.1;
+  constexpr double kFloatUlps = 4.0;  // of float rounding in the device's clip-space products
+  const glm::dmat4 view_proj(view.view_proj);
   // Largest on screen first: their triangles are the likeliest to qualify.
   std::vector<std::pair<double, ObjectId>> candidates;
   for (ObjectId id : drawn) {
@@ -136,18 +138,27 @@ std::size_t check_truth_probes(const FrameLabel& where, const Scene& scene, cons
     const ObjectId id = candidates[i].second;
     const Object& o = scene.object(id);
     const Mesh& m = scene.mesh(o.mesh);
+    const glm::dmat4 transform(o.transform);
     const std::size_t triangles = m.triangle_count();
     const std::size_t tstride = std::max<std::size_t>(1, triangles / 64);
     for (std::size_t t = 0; t < triangles; t += tstride) {
       glm::dvec2 p[3];
       double z[3];
+      double rounding = 0.0;  // bound on the device's float rounding of window depth, over the vertices
       bool usable = true;
       for (int k = 0; k < 3 && usable; ++k) {
-        const glm::vec4 world = o.transform * glm::vec4(m.positions[m.indices[3 * t + std::size_t(k)]], 1.0f);
-        const glm::dvec4 clip(view.view_proj * world);
+        // In double here; the device works in float, whose rounding of the
+        // clip-space dot products grows with the magnitude of world
+        // coordinates (a tiled world's camera is kilometres from the
+        // origin), not with the depth: ~2 ulps of each row's terms.
+        const glm::dvec4 world = transform * glm::dvec4(m.positions[m.indices[3 * t + std::size_t(k)]], 1.0);
+        const glm::dvec4 clip = view_proj * world;
         usable = clip.w > 0.0 && clip.z > -clip.w && clip.z < clip.w;
         p[k] = {(clip.x / clip.w * 0.5 + 0.5) * w, (clip.y / clip.w * 0.5 + 0.5) * h};
         z[k] = clip.z / clip.w * 0.5 + 0.5;
+        double terms = 0.0;
+        for (int j = 0; j < 4; ++j) terms += (std::abs(view_proj[j][2]) + std::abs(view_proj[j][3])) * std::abs(world[j]);
+        rounding = std::max(rounding, 0.5 * kFloatUlps * 0x1p-24 * terms / clip.w);
       }
       if (!usable) continue;
       const double area2 = cross2(p[1] - p[0], p[2] - p[0]);  // twice the signed area, CCW > 0
@@ -170,7 +181,7 @@ std::size_t check_truth_probes(const FrameLabel& where, const Scene& scene, cons
       const double z_tri = lambda[0] * z[0] + lambda[1] * z[1] + lambda[2] * z[2];
       const double dz_dx = ((z[1] - z[0]) * (p[2].y - p[0].y) - (z[2] - z[0]) * (p[1].y - p[0].y)) / area2;
       const double dz_dy = ((z[2] - z[0]) * (p[1].x - p[0].x) - (z[1] - z[0]) * (p[2].x - p[0].x)) / area2;
-      const double slack = kDepthSlack + kSnapPixels * (std::abs(dz_dx) + std::abs(dz_dy));
+      const double slack = kDepthSlack + rounding + kSnapPixels * (std::abs(dz_dx) + std::abs(dz_dy));
       if (z_tri + slack > 1.0 - kDepthSlack) continue;  // too close to the far plane to tell from nothing
       const float z_buf = depth[std::size_t(py) * std::size_t(view.width) + std::size_t(px)];
       if (double(z_buf) > z_tri + slack)

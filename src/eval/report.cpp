@@ -165,7 +165,7 @@ void print_table(const BenchResult& r, std::ostream& out) {
   }
   out << "\nframe ms: wall clock per frame (glFinish closes it)"
       << (r.repeat > 1 ? ", median over repeats" : "")
-      << "; vs vfc / vs orcl: mean frame time over vfc's / oracle's in the same run.\n"
+      << "; vs vfc / vs orcl: mean frame time over vfc's (tilevfc's on a tiled world) / oracle's in the same run.\n"
          "queries, states (render<->query switches), draws, triangles: per frame. missed: objects "
          "visible in the ground truth but not rendered, summed over frames; wrong px: their pixels.\n"
          "cpu ms: the culler's own CPU time (outside backend calls); us/node: that per visited hierarchy node; "

@@ -677,6 +677,10 @@ void Renderer::Impl::upload_dynamic_transforms() {
     glNamedBufferSubData(object_buffer, GLintptr(id * sizeof(glm::mat4)), sizeof(glm::mat4),
                          glm::value_ptr(scene.object(id).transform));
   }
+  for (ObjectId id : scene.moved_objects()) {  // placed anew (a tiled world's window moved)
+    glNamedBufferSubData(object_buffer, GLintptr(id * sizeof(glm::mat4)), sizeof(glm::mat4),
+                         glm::value_ptr(scene.object(id).transform));
+  }
 }
 
 Renderer::Renderer(const Scene& scene, const RendererOptions& options)

@@ -24,6 +24,9 @@ const std::vector<Generator>& generators() {
       {scenes::field_info(), &scenes::make_field},
       {scenes::track_info(), &scenes::make_track},
       {scenes::adversarial_info(), &scenes::make_adversarial},
+      {scenes::tiles_city_info(), &scenes::make_tiles_city},
+      {scenes::tiles_forest_info(), &scenes::make_tiles_forest},
+      {scenes::tiles_hybrid_info(), &scenes::make_tiles_hybrid},
   };
   return all;
 }

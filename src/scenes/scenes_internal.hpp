@@ -34,5 +34,11 @@ SceneBundle make_track(const Params& params);
 
 SceneInfo adversarial_info();
 SceneBundle make_adversarial(const Params& params);
+SceneInfo tiles_city_info();
+SceneBundle make_tiles_city(const Params& params);
+SceneInfo tiles_forest_info();
+SceneBundle make_tiles_forest(const Params& params);
+SceneInfo tiles_hybrid_info();
+SceneBundle make_tiles_hybrid(const Params& params);
 
 }  // namespace occull::scenes

@@ -1,0 +1,107 @@
+// The tile-instance cache of the tiled-world cullers.
+#include "tile_cache.hpp"
+
+#include "occull/error.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <chrono>
+
+namespace occull::detail {
+
+TileCache::TileCache(const SceneIndex& index, std::string local, const Options& options, int evict_after)
+    : index_(index), local_(std::move(local)), options_(options), evict_after_(evict_after) {}
+
+void TileCache::begin_frame(std::uint64_t frame, FrameStats& stats) {
+  frame_ = frame;
+  stats_ = &stats;
+}
+
+TileInstance& TileCache::fetch(TileCoord c) {
+  auto it = cache_.find(c);
+  if (it == cache_.end()) {
+    const auto t0 = std::chrono::steady_clock::now();
+    const TiledWorld& world = *index_.world;
+    TileInstance t;
+    t.coord = c;
+    t.tile = world.tile_at(c);
+    t.first_object = world.first_object(c);
+    const Tile& tile = world.tiles()[t.tile];
+    t.object_count = std::uint32_t(tile.objects.size());
+    t.bvh = std::make_unique<Bvh>(tile.bvh.instance(world.origin(c), t.first_object));
+    if (!local_.empty()) t.local = make_culler(local_, SceneIndex{index_.scene, *t.bvh, nullptr}, options_);
+    it = cache_.emplace(c, std::move(t)).first;
+    if (stats_) {
+      ++stats_->tiles_instantiated;
+      stats_->instantiate_ms +=
+          std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    }
+  }
+  it->second.last_used = frame_;
+  return it->second;
+}
+
+void TileCache::render(TileInstance& t, const View& view, Backend& backend) {
+  if (stats_) ++stats_->tiles_rendered;
+  if (t.local) {
+    const FrameStats s = t.local->render_frame(view, backend);
+    if (stats_) {
+      stats_->nodes_visited += s.nodes_visited;
+      stats_->multiqueries += s.multiqueries;
+      stats_->failed_multiqueries += s.failed_multiqueries;
+      stats_->query_batches += s.query_batches;
+    }
+    return;
+  }
+  all_.clear();
+  for (std::uint32_t i = 0; i < t.object_count; ++i) all_.push_back(t.first_object + i);
+  backend.render(all_);
+}
+
+void TileCache::end_frame() {
+  for (auto it = cache_.begin(); it != cache_.end();) {
+    const bool stale = frame_ - it->second.last_used >= std::uint64_t(evict_after_) ||
+                       !index_.world->in_window(it->first);
+    if (stale) {
+      it = cache_.erase(it);
+      if (stats_) ++stats_->tiles_evicted;
+    } else {
+      ++it;
+    }
+  }
+  if (stats_) stats_->tile_cache = cache_.size();
+  stats_ = nullptr;
+}
+
+const TiledWorld& tiled_world(const SceneIndex& index, std::string_view algorithm) {
+  if (!index.world)
+    throw InputError(fmt::format("{} runs on tiled worlds only (tiles_city, tiles_forest, tiles_hybrid)", algorithm));
+  return *index.world;
+}
+
+void cells_in_frustum(const TiledWorld& world, const View& view, bool tile_box, std::vector<TileCoord>& out) {
+  struct Cell {
+    float distance;
+    TileCoord c;
+  };
+  std::vector<Cell> cells;
+  const TileCoord centre = world.centre();
+  const int r = world.radius();
+  for (int dx = -r; dx <= r; ++dx) {
+    for (int dz = -r; dz <= r; ++dz) {
+      const TileCoord c{centre.x + dx, centre.z + dz};
+      const Aabb box = tile_box ? world.tile_box_at(c) : world.common_box_at(c);
+      if (view.frustum.classify(box) == Containment::outside) continue;
+      const glm::vec3 nearest = glm::clamp(view.eye, box.min, box.max);
+      cells.push_back({glm::length(nearest - view.eye), c});
+    }
+  }
+  std::sort(cells.begin(), cells.end(), [](const Cell& a, const Cell& b) {
+    return a.distance < b.distance || (a.distance == b.distance && a.c < b.c);
+  });
+  out.clear();
+  for (const Cell& cell : cells) out.push_back(cell.c);
+}
+
+}  // namespace occull::detail

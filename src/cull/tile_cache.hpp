@@ -1,0 +1,61 @@
+// Internal: the cache of tile instances the tiled-world cullers share — a
+// tile instance's BVH instance and, with a local culler, its culling
+// context (CHC++), keyed by tile coordinates, reused across frames and
+// freed after a number of frames unused (seed 004, Section III-B).
+#pragma once
+#include "occull/culler.hpp"
+#include "occull/tiles.hpp"
+#include <map>
+#include <memory>
+#include <string>
+
+namespace occull::detail {
+
+struct TileInstance {
+  TileCoord coord;
+  std::uint32_t tile = 0;             ///< index into TiledWorld::tiles()
+  ObjectId first_object = 0;          ///< its objects: first_object + local index
+  std::uint32_t object_count = 0;
+  std::unique_ptr<Bvh> bvh;           ///< the tile's BVH moved to the cell, world ids
+  std::unique_ptr<Culler> local;      ///< its own culler (CHC++ context), or null
+  std::uint64_t last_used = 0;        ///< frame it was last fetched in
+};
+
+class TileCache {
+ public:
+  /// `local`: the algorithm culling inside a tile ("chcpp"), or empty for
+  /// none; it gets `options`. `evict_after`: frames an instance may go unused.
+  TileCache(const SceneIndex& index, std::string local, const Options& options, int evict_after);
+
+  /// Starts frame `frame` (> every earlier one) and counts into `stats`.
+  void begin_frame(std::uint64_t frame, FrameStats& stats);
+  /// fetchBVHInstance: the instance of cell `c`, created on first use.
+  /// Precondition: `c` is in the world's window.
+  TileInstance& fetch(TileCoord c);
+  /// Frees instances unused for `evict_after` frames (after the frame's
+  /// last fetch) and records the cache size in the frame's stats.
+  void end_frame();
+  /// Draws a fetched instance: through its local culler, or all its objects.
+  void render(TileInstance& t, const View& view, Backend& backend);
+
+  [[nodiscard]] std::size_t size() const noexcept { return cache_.size(); }
+
+ private:
+  SceneIndex index_;
+  std::string local_;
+  Options options_;
+  int evict_after_;
+  std::map<TileCoord, TileInstance> cache_;
+  std::uint64_t frame_ = 0;
+  FrameStats* stats_ = nullptr;
+  std::vector<ObjectId> all_;
+};
+
+/// The world of `index`; InputError naming `algorithm` when there is none.
+const TiledWorld& tiled_world(const SceneIndex& index, std::string_view algorithm);
+
+/// Cells of the window whose box (`tile_box`: the tile's own, else the
+/// common box) is not outside the frustum, nearest box first.
+void cells_in_frustum(const TiledWorld& world, const View& view, bool tile_box, std::vector<TileCoord>& out);
+
+}  // namespace occull::detail

@@ -1,0 +1,178 @@
+// `tiles`: tile queries with the common box and per-tile CHC++ over a tiled
+// world (Gomez et al. 2013, seed 004, Algorithms 1-4; occull/tiles.hpp).
+//
+// Each frame starts at the nearest cell whose common box is in the frustum
+// (nothing is drawn yet, so it is visible: closestVisibleTileInFrustum),
+// renders it with its CHC++ context, queries its neighbours with the
+// common box offset to each (queryNeighbors: only those in the frustum and
+// not queried yet this frame, each query kept in a FIFO), and goes on with
+// the next neighbour whose query comes back positive (getNextPositiveQuery).
+// A neighbour seen visible in the previous frame whose result is not ready
+// is rendered at once and its result read at the frame's end
+// (updatePostponedQueryQueue), as the prediction for the next frame.
+//
+// Why a negative query may stop propagation: every cell's query draws the
+// same box, the union of all tiles' boxes, so a cell whose common box is
+// hidden hides whatever tile it holds; and a ray from the eye to a visible
+// point of a farther cell crosses the columns of a chain of neighbouring
+// cells (8-neighbours take the chains through corners) inside their common
+// boxes while it runs inside the boxes' height range, so each of those has a
+// visible point too (seed 004, Section III-C). The verifier checks it.
+#include "cullers.hpp"
+#include "tile_cache.hpp"
+#include "traversal.hpp"
+
+#include <deque>
+#include <map>
+#include <optional>
+
+namespace occull::detail {
+namespace {
+
+class TilesCuller final : public Culler {
+ public:
+  TilesCuller(const SceneIndex& index, const Options& o)
+      : world_(tiled_world(index, "tiles")),
+        cache_(index, o.get_choice("tiles.local", "chcpp", {"chcpp", "none"}) == "chcpp" ? "chcpp" : "", o,
+               o.get_int("tiles.evict", 60, 1, 1000000)),
+        evict_after_(std::uint64_t(o.get_int("tiles.evict", 60, 1, 1000000))),
+        neighbors_(o.get_choice("tiles.neighbors", "8", {"4", "8"}) == "8" ? 8 : 4) {}
+
+  FrameStats render_frame(const View& view, Backend& backend) override {
+    FrameStats stats;
+    stats_ = &stats;
+    backend_ = &backend;
+    view_ = &view;
+    near_radius_ = near_plane_radius(view);
+    cache_.begin_frame(++frame_, stats);
+    // Queries whose results were not ready at the last frame's end: freed now.
+    for (QueryId q : stale_) (void)backend.result(q);
+    stale_.clear();
+
+    pending_.clear();
+    postponed_.clear();
+    std::optional<TileCoord> t = closestVisibleTileInFrustum();
+    if (t) state(*t).queried_frame = frame_;
+    while (t) {
+      cache_.render(cache_.fetch(*t), view, backend);  // renderWithCHC++(fetchBVHInstance(T))
+      queryNeighbors(*t);
+      t = getNextPositiveQuery();
+    }
+    updatePostponedQueryQueue();
+    cache_.end_frame();
+    prune();
+    stats_ = nullptr;
+    return stats;
+  }
+
+ private:
+  struct CellState {
+    std::uint64_t queried_frame = 0;  // last frame its query was issued or it was passed over
+    std::uint64_t visible_for = 0;    // the frame it is predicted visible in (0: none)
+  };
+  struct Pending {
+    QueryId query;
+    TileCoord cell;
+    bool queried;  // false: visible by the eye-inside rule, no query issued
+  };
+
+  CellState& state(TileCoord c) { return cells_[c]; }
+
+  std::optional<TileCoord> closestVisibleTileInFrustum() {
+    cells_in_frustum(world_, *view_, false, in_frustum_);
+    if (in_frustum_.empty()) return std::nullopt;
+    return in_frustum_.front();
+  }
+
+  void queryNeighbors(TileCoord t) {
+    static constexpr int kOffsets[8][2] = {{1, 0}, {-1, 0}, {0, 1}, {0, -1}, {1, 1}, {1, -1}, {-1, 1}, {-1, -1}};
+    for (int i = 0; i < neighbors_; ++i) {
+      const TileCoord n{t.x + kOffsets[i][0], t.z + kOffsets[i][1]};
+      CellState& s = state(n);
+      if (s.queried_frame == frame_) continue;
+      s.queried_frame = frame_;
+      if (!world_.in_window(n)) continue;
+      const Aabb box = world_.common_box_at(n);
+      if (view_->frustum.classify(box) == Containment::outside) continue;
+      // The eye-inside rule: the near plane may clip the faces of a box
+      // around the camera, so such a box is visible without a query.
+      if (near_eye(box, *view_, near_radius_)) {
+        pending_.push_back({0, n, false});
+        continue;
+      }
+      pending_.push_back({backend_->issue_query(std::span<const Aabb>(&box, 1)), n, true});
+      ++stats_->tile_queries;
+    }
+  }
+
+  std::optional<TileCoord> getNextPositiveQuery() {
+    while (!pending_.empty()) {
+      const Pending p = pending_.front();
+      pending_.pop_front();
+      CellState& s = state(p.cell);
+      if (!p.queried) {
+        s.visible_for = frame_ + 1;
+        return p.cell;
+      }
+      if (!backend_->result_available(p.query) && s.visible_for == frame_) {
+        postponed_.push_back(p);
+        ++stats_->tile_postponed;
+        return p.cell;
+      }
+      if (backend_->result(p.query) > 0) {
+        s.visible_for = frame_ + 1;
+        return p.cell;
+      }
+      s.visible_for = 0;
+    }
+    return std::nullopt;
+  }
+
+  void updatePostponedQueryQueue() {
+    for (const Pending& p : postponed_) {
+      CellState& s = state(p.cell);
+      if (backend_->result_available(p.query)) {
+        s.visible_for = backend_->result(p.query) > 0 ? frame_ + 1 : 0;
+      } else {
+        s.visible_for = 0;
+        ++stats_->tile_prediction_failures;
+        stale_.push_back(p.query);
+      }
+    }
+    postponed_.clear();
+  }
+
+  // Forgets cells not queried for the eviction time (their prediction is
+  // long stale) and cells that left the window.
+  void prune() {
+    for (auto it = cells_.begin(); it != cells_.end();) {
+      if (frame_ - it->second.queried_frame >= evict_after_ || !world_.in_window(it->first))
+        it = cells_.erase(it);
+      else
+        ++it;
+    }
+  }
+
+  const TiledWorld& world_;
+  TileCache cache_;
+  std::uint64_t evict_after_;
+  int neighbors_;
+  std::uint64_t frame_ = 0;
+  std::map<TileCoord, CellState> cells_;
+  std::deque<Pending> pending_;    // Q: queries in issue order (results come back in order)
+  std::vector<Pending> postponed_; // P
+  std::vector<QueryId> stale_;     // postponed queries given up on at the last frame's end
+  std::vector<TileCoord> in_frustum_;
+  FrameStats* stats_ = nullptr;
+  Backend* backend_ = nullptr;
+  const View* view_ = nullptr;
+  float near_radius_ = 0.0f;
+};
+
+}  // namespace
+
+std::unique_ptr<Culler> make_tiles(const SceneIndex& index, const Options& options) {
+  return std::make_unique<TilesCuller>(index, options);
+}
+
+}  // namespace occull::detail
