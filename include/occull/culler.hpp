@@ -126,7 +126,8 @@ struct AlgorithmSpec {
 
 /// Whether a run of `spec` must never cull a visible object: its algorithm
 /// is conservative and no option makes it approximate — `threshold` > 0
-/// culls nodes with up to that many visible pixels, so such a run may pop.
+/// culls nodes with up to that many visible pixels, and `tiles.box=tile`
+/// queries a tile's own box instead of the common box, so such runs may pop.
 /// The harness reports misses of a conservative run as failures and those
 /// of any other run as popping.
 [[nodiscard]] bool is_conservative(const AlgorithmSpec& spec);

@@ -120,6 +120,11 @@ class TiledWorld {
   /// entered it. Starts with Scene::clear_moved(), so moved_objects() lists
   /// the ids placed by this call. Returns the number of cells placed.
   std::size_t follow(Scene& scene, const glm::vec3& eye);
+  /// Whether every point of `view`'s frustum lies over the window's cells
+  /// (its eight corners do: the frustum is their convex hull), so that the
+  /// placed cells are all a frame can see. The harness checks it on every
+  /// ground-truth frame.
+  [[nodiscard]] bool covers(const View& view) const;
   /// Cells placed since construction (a measure of the walk).
   [[nodiscard]] std::uint64_t cells_placed() const noexcept { return cells_placed_; }
   /// "tile NAME at (x, z), object i": what object `id` is now.

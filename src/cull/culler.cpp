@@ -123,7 +123,8 @@ const std::vector<Entry>& registry() {
         true,
         {{"local", "chcpp", "culling inside a visible tile: chcpp (its own CHC++ context) or none (draw the whole tile)"},
          {"evict", "60", "frames a tile instance may go unused before its BVH instance and CHC++ context are freed"},
-         {"neighbors", "8", "neighbours a visible tile queries: 4 (edges) or 8 (edges and corners)"}},
+         {"neighbors", "8", "neighbours a visible tile queries: 4 (edges) or 8 (edges and corners)"},
+         {"box", "common", "box a tile query draws: common (the union of every tile's box) or tile (the queried tile's own box: not conservative, seed 004's Figure 7, kept to show why)"}},
         false, SceneKind::tiled},
        &detail::make_tiles},
       {{"oracle",
@@ -294,7 +295,11 @@ AlgorithmSpec parse_algorithm_spec(std::string_view spec, const Options& base) {
 bool is_conservative(const AlgorithmSpec& spec) {
   if (!find_algorithm(spec.name).conservative) return false;
   const std::string threshold = spec.name + ".threshold";
-  return !spec.options.has(threshold) || spec.options.get_int(threshold, 0, 0, 1 << 24) == 0;
+  if (spec.options.has(threshold) && spec.options.get_int(threshold, 0, 0, 1 << 24) != 0) return false;
+  // Tile queries over each tile's own box instead of the common box: the
+  // counterexample of seed 004's Figure 7.
+  return !(spec.name == "tiles" && spec.options.has("tiles.box") &&
+           spec.options.get_choice("tiles.box", "common", {"common", "tile"}) == "tile");
 }
 
 std::unique_ptr<Culler> make_culler(std::string_view name, const SceneIndex& index,

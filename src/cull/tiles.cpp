@@ -36,7 +36,8 @@ class TilesCuller final : public Culler {
         cache_(index, o.get_choice("tiles.local", "chcpp", {"chcpp", "none"}) == "chcpp" ? "chcpp" : "", o,
                o.get_int("tiles.evict", 60, 1, 1000000)),
         evict_after_(std::uint64_t(o.get_int("tiles.evict", 60, 1, 1000000))),
-        neighbors_(o.get_choice("tiles.neighbors", "8", {"4", "8"}) == "8" ? 8 : 4) {}
+        neighbors_(o.get_choice("tiles.neighbors", "8", {"4", "8"}) == "8" ? 8 : 4),
+        common_box_(o.get_choice("tiles.box", "common", {"common", "tile"}) == "common") {}
 
   FrameStats render_frame(const View& view, Backend& backend) override {
     FrameStats stats;
@@ -92,7 +93,7 @@ class TilesCuller final : public Culler {
       if (s.queried_frame == frame_) continue;
       s.queried_frame = frame_;
       if (!world_.in_window(n)) continue;
-      const Aabb box = world_.common_box_at(n);
+      const Aabb box = common_box_ ? world_.common_box_at(n) : world_.tile_box_at(n);  // commonBboxAtOffset(n)
       if (view_->frustum.classify(box) == Containment::outside) continue;
       // The eye-inside rule: the near plane may clip the faces of a box
       // around the camera, so such a box is visible without a query.
@@ -157,6 +158,7 @@ class TilesCuller final : public Culler {
   TileCache cache_;
   std::uint64_t evict_after_;
   int neighbors_;
+  bool common_box_;  // false: each tile's own box (tiles.box=tile, not conservative)
   std::uint64_t frame_ = 0;
   std::map<TileCoord, CellState> cells_;
   std::deque<Pending> pending_;    // Q: queries in issue order (results come back in order)

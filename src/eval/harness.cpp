@@ -215,8 +215,15 @@ std::vector<FrameTruth> Session::ground_truth(const CameraPath& path, int frames
   for (int k = 0; k < frames; ++k) {
     bundle_.scene.update(frame_time(path, k, frames));
     const View view = view_at(path, k, frames);
-    if (bundle_.world) bundle_.world->follow(bundle_.scene, view.eye);
     const detail::FrameLabel where{scene_spec_, path.name(), k};
+    if (bundle_.world) {
+      bundle_.world->follow(bundle_.scene, view.eye);
+      // The truth sees only the placed cells: the window must hold the frustum.
+      if (!bundle_.world->covers(view))
+        detail::invariant_violated(where, "window-covers-frustum",
+                                   fmt::format("the frustum reaches past the {} x {} cells placed around the eye",
+                                               2 * bundle_.world->radius() + 1, 2 * bundle_.world->radius() + 1));
+    }
     const auto step = watchdog_->step(fmt::format("ground-truth frame {} of path {}", k, path.name()));
     in_frustum.clear();
     for (ObjectId id = 0; id < objects.size(); ++id)
