@@ -71,12 +71,22 @@ std::vector<ObjectId> check_frame(std::span<const gl::Renderer::ObjectPixels> tr
                                   FrameStats& stats);
 
 /// Frames of one algorithm over a path (one repeat).
+/// The process's memory after a frame of a run (every kMemorySampleFrames).
+struct MemorySample {
+  int frame = 0;        ///< frames of the run done (1000, 2000, ...)
+  double rss_mb = 0.0;  ///< resident set of the process, MiB
+  double gpu_mb = 0.0;  ///< the renderer's buffer objects as GL sizes them, MiB
+};
+/// Frames between two MemorySamples of a run.
+inline constexpr int kMemorySampleFrames = 1000;
+
 struct AlgorithmRun {
   std::string name;
   int repeat = 0;
   bool conservative = true;  ///< must miss nothing (is_conservative of its spec)
   std::vector<FrameStats> frames;
   std::uint32_t longest_miss_frames = 0;  ///< longest run of frames one object stayed missed
+  std::vector<MemorySample> memory;       ///< after every kMemorySampleFrames frames
 };
 
 /// How long objects stay missed over consecutive frames of one run.
@@ -328,6 +338,16 @@ struct AlgorithmSummary {
   std::uint64_t worst_frame_wrong_pixels = 0;
   std::uint32_t longest_miss_frames = 0;
   std::uint64_t truth_object_frames = 0;  ///< sum over frames of the objects visible in the truth
+  // Tiled worlds (FrameStats' tile counters): per frame, and in all.
+  double tiles_rendered_per_frame = 0.0;
+  double tile_queries_per_frame = 0.0;
+  double tile_postponed_per_frame = 0.0;
+  double tile_prediction_failure_share = 0.0;  ///< prediction failures / tile queries, over the run
+  double tiles_instantiated = 0.0;             ///< tile instances created over the run
+  double tiles_evicted = 0.0;                  ///< ... and freed
+  double tile_cache_max = 0.0;                 ///< most tile instances held after a frame
+  double instantiate_ms_per_tile = 0.0;        ///< mean time to create one tile instance, ms
+  std::vector<MemorySample> memory;            ///< of the first repeat's run
   /// missed_objects / truth_object_frames: the share of visible object-frames missed (0 unverified).
   [[nodiscard]] double missed_share() const noexcept {
     return truth_object_frames > 0 ? double(missed_objects) / double(truth_object_frames) : 0.0;
@@ -342,6 +362,8 @@ struct BenchResult {
   std::size_t objects = 0;
   std::uint64_t triangles = 0;
   std::size_t bvh_nodes = 0;
+  /// A tiled world in words (its tiles, cells placed, tile BVHs); empty otherwise.
+  std::string tiled_world;
   double scene_build_ms = 0.0;
   double bvh_build_ms = 0.0;
   int frames = 0;

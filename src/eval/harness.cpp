@@ -339,6 +339,11 @@ AlgorithmRun Session::run_path(std::string_view name, Culler& culler, const Came
     if (predict) s.model_ms = predicted_frame_ms(view_at(path, k, frames));
     if (truth) misses.add(verify_frame(name, culler, path, k, (*truth)[std::size_t(k)], s));
     run.frames.push_back(s);
+    if ((k + 1) % kMemorySampleFrames == 0) {
+      const MemoryUsage m = memory_usage();
+      run.memory.push_back({k + 1, double(m.resident_bytes) / (1 << 20),
+                            double(renderer_->resources().buffer_bytes) / (1 << 20)});
+    }
     if (progress) progress(name, k, frames, false);
   }
   run.longest_miss_frames = misses.longest();
@@ -403,6 +408,7 @@ std::vector<AlgorithmSummary> summarize_runs(std::span<const AlgorithmRun> runs)
       std::vector<double> ms;
       std::map<std::string, double> sums;
       std::uint64_t missed = 0, frames_missing = 0, wrong = 0, worst = 0, truth = 0;
+      double tile_cache_max = 0.0;
       for (const FrameStats& f : r.frames) {
         ms.push_back(f.frame_ms);
         sums["queries"] += double(f.queries);
@@ -421,6 +427,14 @@ std::vector<AlgorithmSummary> summarize_runs(std::span<const AlgorithmRun> runs)
         sums["conditional_objects"] += double(f.conditional_objects);
         sums["conditional_skipped"] += double(f.conditional_skipped);
         sums["stalled"] += double(f.stalled);
+        sums["tiles_rendered"] += double(f.tiles_rendered);
+        sums["tile_queries"] += double(f.tile_queries);
+        sums["tile_postponed"] += double(f.tile_postponed);
+        sums["tile_prediction_failures"] += double(f.tile_prediction_failures);
+        sums["tiles_instantiated"] += double(f.tiles_instantiated);
+        sums["tiles_evicted"] += double(f.tiles_evicted);
+        sums["instantiate_ms"] += f.instantiate_ms;
+        tile_cache_max = std::max(tile_cache_max, double(f.tile_cache));
         sums["nodes_visited"] += double(f.nodes_visited);
         sums["extra_objects"] += double(f.extra_objects);
         sums["wait_ms"] += f.wait_ms;
@@ -444,6 +458,15 @@ std::vector<AlgorithmSummary> summarize_runs(std::span<const AlgorithmRun> runs)
       per_repeat["p95"].push_back(s.p95);
       per_repeat["max"].push_back(s.max);
       for (const auto& [key, sum] : sums) per_repeat[key].push_back(sum / n);
+      // Totals over the run rather than per frame.
+      per_repeat["tiles_instantiated_total"].push_back(sums["tiles_instantiated"]);
+      per_repeat["tiles_evicted_total"].push_back(sums["tiles_evicted"]);
+      per_repeat["tile_cache_max"].push_back(tile_cache_max);
+      if (sums["tile_queries"] > 0)
+        per_repeat["tile_prediction_failure_share"].push_back(sums["tile_prediction_failures"] / sums["tile_queries"]);
+      if (sums["tiles_instantiated"] > 0)
+        per_repeat["instantiate_ms_per_tile"].push_back(sums["instantiate_ms"] / sums["tiles_instantiated"]);
+      if (r.repeat == 0) a.memory = r.memory;
       if (sums["nodes_visited"] > 0) per_repeat["cpu_us_per_node"].push_back(1e3 * sums["cpu_ms"] / sums["nodes_visited"]);
       // A view of a split-screen run compares with the same view of the baseline.
       const std::size_t view_at = r.name.find(" [view ");
@@ -499,6 +522,14 @@ std::vector<AlgorithmSummary> summarize_runs(std::span<const AlgorithmRun> runs)
     a.kernel_ms_per_frame = med("kernel_ms");
     a.minor_faults_per_frame = med("minor_faults");
     a.major_faults_per_frame = med("major_faults");
+    a.tiles_rendered_per_frame = med("tiles_rendered");
+    a.tile_queries_per_frame = med("tile_queries");
+    a.tile_postponed_per_frame = med("tile_postponed");
+    a.tile_prediction_failure_share = med("tile_prediction_failure_share");
+    a.tiles_instantiated = med("tiles_instantiated_total");
+    a.tiles_evicted = med("tiles_evicted_total");
+    a.tile_cache_max = med("tile_cache_max");
+    a.instantiate_ms_per_tile = med("instantiate_ms_per_tile");
     out.push_back(std::move(a));
   }
   return out;
@@ -715,6 +746,20 @@ BenchResult run_bench(const BenchConfig& config, const ProgressFn& progress) {
   result.objects = session.bundle().scene.objects().size();
   result.triangles = session.bundle().scene.triangle_count();
   result.bvh_nodes = session.bvh().size();
+  if (const TiledWorld* w = session.bundle().world.get()) {
+    std::size_t nodes = 0;
+    double build_ms = 0.0;
+    for (const Tile& t : w->tiles()) {
+      nodes += t.bvh.size();
+      build_ms += t.bvh_build_ms;
+    }
+    const glm::vec3 box = w->common_box().extent();
+    const int side = 2 * w->radius() + 1;
+    result.tiled_world = fmt::format(
+        "tiled world: {} tiles in {:g} m cells, common box {:.0f} x {:.0f} x {:.0f} m; {} x {} cells placed around "
+        "the eye; tile BVHs {} nodes in all, built in {:.1f} ms",
+        w->tiles().size(), w->cell_size(), box.x, box.y, box.z, side, side, nodes, build_ms);
+  }
   result.scene_build_ms = session.scene_build_ms();
   result.bvh_build_ms = session.bvh_build_ms();
   result.frames = config.frames;

@@ -93,11 +93,14 @@ std::string sampling_text(const BenchResult& r) {
 }
 
 std::string setup_line(const BenchResult& r) {
-  return fmt::format("scene {} ({} objects, {} triangles; BVH {} nodes in {:.1f} ms), path {}, {} frames "
-                     "at {}x{}, {} warm-up, {} repeat{}, {}\n{}",
-                     r.scene, r.objects, r.triangles, r.bvh_nodes, r.bvh_build_ms, r.path, r.frames,
+  const std::string index = r.tiled_world.empty()
+                                ? fmt::format("BVH {} nodes in {:.1f} ms", r.bvh_nodes, r.bvh_build_ms)
+                                : "objects and triangles of the placed cells";
+  return fmt::format("scene {} ({} objects, {} triangles; {}), path {}, {} frames "
+                     "at {}x{}, {} warm-up, {} repeat{}, {}\n{}{}",
+                     r.scene, r.objects, r.triangles, index, r.path, r.frames,
                      r.width, r.height, r.warmup, r.repeat, r.repeat == 1 ? "" : "s", verification_text(r),
-                     sampling_text(r));
+                     sampling_text(r), r.tiled_world.empty() ? "" : "\n" + r.tiled_world);
 }
 
 std::string misses_text(const BenchResult& r, std::uint64_t v) {
@@ -146,6 +149,28 @@ void print_table(const BenchResult& r, std::ostream& out) {
                          "by the device (their query found them hidden)\n",
                          a.name, a.conditional_objects_per_frame, a.conditional_skipped_per_frame);
   }
+  if (std::any_of(r.summaries.begin(), r.summaries.end(), [](const AlgorithmSummary& a) { return a.tiles_rendered_per_frame > 0; })) {
+    out << fmt::format("\ntiled world (per frame; instances and evictions over the run)\n{:<{}} {:>7} {:>8} {:>9} {:>9} {:>8} {:>8} {:>7} {:>9}\n",
+                       "algorithm", w, "tiles", "t.query", "postponed", "failed %", "created", "evicted", "cache",
+                       "ms/tile");
+    for (const AlgorithmSummary& a : r.summaries) {
+      if (a.tiles_rendered_per_frame <= 0) continue;
+      out << fmt::format("{:<{}} {:>7.1f} {:>8.1f} {:>9.2f} {:>9.3f} {:>8.0f} {:>8.0f} {:>7.0f} {:>9.3f}\n", a.name, w,
+                         a.tiles_rendered_per_frame, a.tile_queries_per_frame, a.tile_postponed_per_frame,
+                         100.0 * a.tile_prediction_failure_share, a.tiles_instantiated, a.tiles_evicted,
+                         a.tile_cache_max, a.instantiate_ms_per_tile);
+    }
+  }
+  for (const AlgorithmSummary& a : r.summaries) {
+    if (a.memory.size() < 2) continue;
+    const MemorySample& first = a.memory.front();
+    const MemorySample& last = a.memory.back();
+    out << fmt::format("{}: memory after {}k frames {:.1f} MiB resident, {:.1f} MiB GL buffers; after {}k {:.1f} MiB "
+                       "({:+.1f}%), {:.1f} MiB ({:+.1f}%)\n",
+                       a.name, first.frame / 1000, first.rss_mb, first.gpu_mb, last.frame / 1000, last.rss_mb,
+                       first.rss_mb > 0 ? 100.0 * (last.rss_mb / first.rss_mb - 1.0) : 0.0, last.gpu_mb,
+                       first.gpu_mb > 0 ? 100.0 * (last.gpu_mb / first.gpu_mb - 1.0) : 0.0);
+  }
   out << fmt::format("\nwhere the time goes (per frame)\n{:<{}} {:>7} {:>8} {:>8} {:>8} {:>7} {:>8} {:>8} {:>8} {:>7}\n",
                      "algorithm", w, "cpu ms", "us/node", "nodes", "wait ms", "waits", "flushes", "gpu ms",
                      "faults", "sys ms");
@@ -187,6 +212,7 @@ nlohmann::ordered_json detail::bench_json(const BenchResult& r) {
                   {"objects", r.objects},
                   {"triangles", r.triangles},
                   {"bvh_nodes", r.bvh_nodes},
+                  {"tiled_world", r.tiled_world.empty() ? ordered_json() : ordered_json(r.tiled_world)},
                   {"bvh_build_ms", r.bvh_build_ms}};
   doc["path"] = r.path;
   doc["frames"] = r.frames;
@@ -249,7 +275,19 @@ nlohmann::ordered_json detail::bench_json(const BenchResult& r) {
                      {"kernel_ms_per_frame", a.kernel_ms_per_frame},
                      {"minor_faults_per_frame", a.minor_faults_per_frame},
                      {"major_faults_per_frame", a.major_faults_per_frame},
-                     {"model_ms_per_frame", r.modelled ? ordered_json(a.model_ms_per_frame) : ordered_json()}});
+                     {"model_ms_per_frame", r.modelled ? ordered_json(a.model_ms_per_frame) : ordered_json()},
+                     {"tiles_rendered_per_frame", a.tiles_rendered_per_frame},
+                     {"tile_queries_per_frame", a.tile_queries_per_frame},
+                     {"tile_postponed_per_frame", a.tile_postponed_per_frame},
+                     {"tile_prediction_failure_share", a.tile_prediction_failure_share},
+                     {"tiles_instantiated", a.tiles_instantiated},
+                     {"tiles_evicted", a.tiles_evicted},
+                     {"tile_cache_max", a.tile_cache_max},
+                     {"instantiate_ms_per_tile", a.instantiate_ms_per_tile}});
+    ordered_json memory = ordered_json::array();
+    for (const MemorySample& m : a.memory)
+      memory.push_back({{"frame", m.frame}, {"rss_mb", m.rss_mb}, {"gpu_mb", m.gpu_mb}});
+    algos.back()["memory"] = memory;
   }
   doc["algorithms"] = algos;
   return doc;
