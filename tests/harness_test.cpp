@@ -291,6 +291,23 @@ TEST_F(HarnessTest, OracleWithoutTruthIsRefused) {
   EXPECT_THROW(session_->run_path("oracle", *oracle, *path_, 2, nullptr), InputError);
 }
 
+TEST(Harness, RecordsMemoryEveryThousandFrames) {
+  Session session("tiles_city:far=150", test::small_target(64, 36));
+  auto culler = session.make("tiles", {});
+  const AlgorithmRun run = session.run_path("tiles", *culler, session.path("walk10k"), 2000, nullptr);
+  ASSERT_EQ(run.memory.size(), 2u);
+  EXPECT_EQ(run.memory[0].frame, 1000);
+  EXPECT_EQ(run.memory[1].frame, 2000);
+  for (const MemorySample& m : run.memory) {
+    EXPECT_GT(m.rss_mb, 10.0);
+    EXPECT_GT(m.gpu_mb, 0.0) << "the meshes and the transforms of the window are in GL buffers";
+  }
+  const auto summary = summarize_runs(std::span<const AlgorithmRun>(&run, 1));
+  EXPECT_EQ(summary[0].memory.size(), 2u);
+  EXPECT_GT(summary[0].tiles_rendered_per_frame, 0.0);
+  EXPECT_GT(summary[0].tiles_instantiated, 0.0);
+}
+
 TEST(Report, JsonCarriesEveryDocumentedField) {
   BenchConfig c;
   c.scene = kSmallCity;
@@ -300,9 +317,13 @@ TEST(Report, JsonCarriesEveryDocumentedField) {
   c.repeat = 2;
   c.width = 96;
   c.height = 54;
-  const BenchResult r = run_bench(c);
+  BenchResult r = run_bench(c);
   EXPECT_EQ(r.runs.size(), 6u);
   EXPECT_EQ(r.runs[3].name, "vfc");  // interleaved: A B C A B C
+  // Memory is sampled every 1000 frames (Harness.RecordsMemoryEveryThousandFrames):
+  // one sample stands in, so that its fields are seen.
+  EXPECT_TRUE(r.summaries[0].memory.empty());
+  r.summaries[0].memory.push_back({1000, 100.0, 2.0});
   std::ostringstream out;
   write_json(r, out);
   const auto doc = nlohmann::json::parse(out.str());

@@ -302,19 +302,23 @@ void write_csv(const BenchResult& r, std::ostream& out) {
          "failed_multiqueries,query_batches,state_changes,material_changes,render_flushes,"
          "draw_calls,triangles,objects_rendered,nodes_visited,truth_objects,missed_objects,"
          "wrong_pixels,extra_objects,blocking_waits,model_ms,kernel_ms,minor_faults,major_faults,flushes,"
-         "capped,over_cap,result_age,revealed,conditional_objects,conditional_skipped,stalled\n";
+         "capped,over_cap,result_age,revealed,conditional_objects,conditional_skipped,stalled,"
+         "tiles_rendered,tile_queries,tile_postponed,tile_prediction_failures,tiles_instantiated,tiles_evicted,"
+         "tile_cache,instantiate_ms\n";
   for (const AlgorithmRun& run : r.runs) {
     for (std::size_t k = 0; k < run.frames.size(); ++k) {
       const FrameStats& f = run.frames[k];
       out << fmt::format("{},{},{},{:.4f},{:.4f},{:.4f},{:.4f},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},"
-                         "{:.4f},{:.4f},{},{},{},{},{},{:.3f},{},{},{},{}\n",
+                         "{:.4f},{:.4f},{},{},{},{},{},{:.3f},{},{},{},{},{},{},{},{},{},{},{},{:.4f}\n",
                          run.name, run.repeat, k, f.frame_ms, f.cpu_ms, f.wait_ms, f.gpu_ms, f.queries,
                          f.query_boxes, f.multiqueries, f.failed_multiqueries, f.query_batches,
                          f.state_changes, f.material_changes, f.render_flushes, f.draw_calls,
                          f.triangles, f.objects_rendered, f.nodes_visited, f.truth_objects,
                          f.missed_objects, f.wrong_pixels, f.extra_objects, f.blocking_waits, f.model_ms,
                          f.kernel_ms, f.minor_faults, f.major_faults, f.flushes, f.capped, f.over_cap,
-                         f.result_age, f.revealed, f.conditional_objects, f.conditional_skipped, f.stalled);
+                         f.result_age, f.revealed, f.conditional_objects, f.conditional_skipped, f.stalled,
+                         f.tiles_rendered, f.tile_queries, f.tile_postponed, f.tile_prediction_failures,
+                         f.tiles_instantiated, f.tiles_evicted, f.tile_cache, f.instantiate_ms);
     }
   }
 }

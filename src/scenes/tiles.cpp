@@ -73,10 +73,11 @@ Shared add_shared(Scene& scene) {
   for (int v = 0; v < 3; ++v) {
     MeshBuilder b;
     const float h = 9.0f + 3.0f * float(v);
-    b.prism({0, 0, 0}, 0.3f, 2.5f, 6);
-    b.cone({0, 2.0f, 0}, 2.6f + 0.3f * float(v), h * 0.55f, 10);
-    b.cone({0, 2.0f + h * 0.3f, 0}, 2.0f + 0.2f * float(v), h * 0.5f, 10);
-    b.cone({0, 2.0f + h * 0.55f, 0}, 1.3f, h * 0.45f, 10);
+    // Spruces: branches down to the ground (a forest is dense at eye height).
+    b.prism({0, 0, 0}, 0.3f, 1.0f, 6);
+    b.cone({0, 0.4f, 0}, 2.6f + 0.3f * float(v), h * 0.55f, 10);
+    b.cone({0, 0.4f + h * 0.3f, 0}, 2.0f + 0.2f * float(v), h * 0.5f, 10);
+    b.cone({0, 0.4f + h * 0.55f, 0}, 1.3f, h * 0.45f, 10);
     s.trees[v] = scene.add_mesh(b.take());
   }
   for (int v = 0; v < 2; ++v) {
