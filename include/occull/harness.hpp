@@ -87,6 +87,7 @@ struct AlgorithmRun {
   std::vector<FrameStats> frames;
   std::uint32_t longest_miss_frames = 0;  ///< longest run of frames one object stayed missed
   std::vector<MemorySample> memory;       ///< after every kMemorySampleFrames frames
+  std::string first_miss;                 ///< "frame K: <describe_object>" of the first missed object; empty if none
 };
 
 /// How long objects stay missed over consecutive frames of one run.
@@ -177,6 +178,10 @@ class Session {
   /// the verification figures of `stats` and returns the missed ids.
   std::vector<ObjectId> verify_frame(std::string_view name, const Culler& culler, const CameraPath& path, int k,
                                      const FrameTruth& truth, FrameStats& stats);
+  /// What object `id` is now, for a person: "tile city-3 at (0, -97),
+  /// object 12" in a tiled world (its ids are reused as the window moves),
+  /// else "object 812 (mesh 5)".
+  [[nodiscard]] std::string describe_object(ObjectId id) const;
 
   /// With `predict`, also fills FrameStats::model_ms (see predicted_frame_ms).
   /// With `truth`, checks every frame against it (frame-within-truth, and
@@ -348,6 +353,7 @@ struct AlgorithmSummary {
   double tile_cache_max = 0.0;                 ///< most tile instances held after a frame
   double instantiate_ms_per_tile = 0.0;        ///< mean time to create one tile instance, ms
   std::vector<MemorySample> memory;            ///< of the first repeat's run
+  std::string first_miss;                      ///< of the first run that missed (AlgorithmRun::first_miss)
   /// missed_objects / truth_object_frames: the share of visible object-frames missed (0 unverified).
   [[nodiscard]] double missed_share() const noexcept {
     return truth_object_frames > 0 ? double(missed_objects) / double(truth_object_frames) : 0.0;

@@ -337,7 +337,12 @@ AlgorithmRun Session::run_path(std::string_view name, Culler& culler, const Came
   for (int k = 0; k < frames; ++k) {
     FrameStats s = run_path_frame(culler, path, k, frames, truth);
     if (predict) s.model_ms = predicted_frame_ms(view_at(path, k, frames));
-    if (truth) misses.add(verify_frame(name, culler, path, k, (*truth)[std::size_t(k)], s));
+    if (truth) {
+      const std::vector<ObjectId> missed = verify_frame(name, culler, path, k, (*truth)[std::size_t(k)], s);
+      if (!missed.empty() && run.first_miss.empty())
+        run.first_miss = fmt::format("frame {}: {}", k, describe_object(missed.front()));
+      misses.add(missed);
+    }
     run.frames.push_back(s);
     if ((k + 1) % kMemorySampleFrames == 0) {
       const MemoryUsage m = memory_usage();
@@ -348,6 +353,12 @@ AlgorithmRun Session::run_path(std::string_view name, Culler& culler, const Came
   }
   run.longest_miss_frames = misses.longest();
   return run;
+}
+
+std::string Session::describe_object(ObjectId id) const {
+  if (bundle_.world) return bundle_.world->describe(id);
+  if (id >= bundle_.scene.objects().size()) return fmt::format("object {} (not in the scene)", id);
+  return fmt::format("object {} (mesh {})", id, bundle_.scene.object(id).mesh);
 }
 
 std::vector<ObjectId> Session::verify_frame(std::string_view name, const Culler& culler, const CameraPath& path,
@@ -467,6 +478,7 @@ std::vector<AlgorithmSummary> summarize_runs(std::span<const AlgorithmRun> runs)
       if (sums["tiles_instantiated"] > 0)
         per_repeat["instantiate_ms_per_tile"].push_back(sums["instantiate_ms"] / sums["tiles_instantiated"]);
       if (r.repeat == 0) a.memory = r.memory;
+      if (a.first_miss.empty()) a.first_miss = r.first_miss;
       if (sums["nodes_visited"] > 0) per_repeat["cpu_us_per_node"].push_back(1e3 * sums["cpu_ms"] / sums["nodes_visited"]);
       // A view of a split-screen run compares with the same view of the baseline.
       const std::size_t view_at = r.name.find(" [view ");

@@ -59,9 +59,10 @@ std::vector<std::string> verdict_lines(const BenchResult& r) {
     if (a.conservative) {
       exact += (exact.empty() ? "" : ", ") + a.name;
     } else {
-      popping += fmt::format("{}{}: {} missed ({:.2f}% of the visible object-frames) over {} frames, longest {} frames",
+      popping += fmt::format("{}{}: {} missed ({:.2f}% of the visible object-frames) over {} frames, longest {} frames{}",
                              popping.empty() ? "" : "; ", a.name, a.missed_objects, 100.0 * a.missed_share(),
-                             a.frames_with_misses, a.longest_miss_frames);
+                             a.frames_with_misses, a.longest_miss_frames,
+                             a.first_miss.empty() ? "" : " (first, " + a.first_miss + ")");
     }
   }
   const auto failures = verification_failures(r);
@@ -71,8 +72,9 @@ std::vector<std::string> verdict_lines(const BenchResult& r) {
   } else {
     std::string which;
     for (const AlgorithmSummary* a : failures)
-      which += fmt::format("{}{} missed {} visible objects in {} frames", which.empty() ? "" : "; ", a->name,
-                           a->missed_objects, a->frames_with_misses);
+      which += fmt::format("{}{} missed {} visible objects in {} frames{}", which.empty() ? "" : "; ", a->name,
+                           a->missed_objects, a->frames_with_misses,
+                           a->first_miss.empty() ? "" : " (first, " + a->first_miss + ")");
     lines.push_back("verification FAILED: conservative algorithms culled visible objects: " + which);
   }
   if (!popping.empty())
@@ -283,7 +285,8 @@ nlohmann::ordered_json detail::bench_json(const BenchResult& r) {
                      {"tiles_instantiated", a.tiles_instantiated},
                      {"tiles_evicted", a.tiles_evicted},
                      {"tile_cache_max", a.tile_cache_max},
-                     {"instantiate_ms_per_tile", a.instantiate_ms_per_tile}});
+                     {"instantiate_ms_per_tile", a.instantiate_ms_per_tile},
+                     {"first_miss", a.first_miss.empty() ? ordered_json() : ordered_json(a.first_miss)}});
     ordered_json memory = ordered_json::array();
     for (const MemorySample& m : a.memory)
       memory.push_back({{"frame", m.frame}, {"rss_mb", m.rss_mb}, {"gpu_mb", m.gpu_mb}});
