@@ -65,7 +65,7 @@ TEST(ConservativeCullers, MissNothingWhenTheCameraPassesThroughObjects) {
 // Seed 004's cullers on each tiling set and path (frames spread over each
 // path: walk10k's 10 km, the grazing flight), with both neighbourhoods.
 TEST(ConservativeCullers, MissNothingOnTiledWorlds) {
-  const char* const kTiled[] = {"tilevfc", "pertile", "tiles", "tiles:local=none", "tiles:neighbors=4"};
+  const char* const kTiled[] = {"tilevfc", "pertile", "tiles", "tiles:local=none", "tiles:neighbors=4", "tiles:requery=4"};
   for (const char* scene : {"tiles_city:far=200", "tiles_forest:far=150", "tiles_hybrid:far=200"}) {
     Session session(scene, small_target());
     for (const auto& path : session.bundle().paths) {

@@ -300,3 +300,25 @@ TEST(TileCache, InstancesUnusedForTheEvictionTimeAreFreed) {
   const auto side = std::uint64_t(2 * t.bundle.world->radius() + 1);
   EXPECT_LE(s.tile_cache, side * side);
 }
+
+TEST(TilesCuller, RequeryDrawsVisibleTilesWithoutQueriesBetweenTheirReQueries) {
+  TiledCase t;
+  const View v = t.look({1.0f, 1.7f, -20.0f}, 0.3f, -0.05f);
+  std::uint64_t queries[2] = {0, 0}, drawn[2] = {0, 0};
+  for (int variant = 0; variant < 2; ++variant) {
+    test::RecordingBackend backend;
+    Options o;
+    o.set("tiles.local=none");
+    if (variant == 1) o.set("tiles.requery=4");
+    auto culler = make_culler("tiles", t.index(), o);
+    for (int f = 0; f < 8; ++f) {
+      const FrameStats s = culler->render_frame(v, backend);
+      if (f == 0) continue;  // the first frame queries every tile either way
+      queries[variant] += s.tile_queries;
+      drawn[variant] += s.tiles_rendered;
+    }
+  }
+  EXPECT_EQ(drawn[1], drawn[0]) << "the same tiles are drawn";
+  EXPECT_LT(queries[1], queries[0] / 2) << "visible tiles are queried every 4th frame";
+  EXPECT_GT(queries[1], 0u) << "but they are queried again";
+}

@@ -142,6 +142,9 @@ class Scene {
   std::vector<glm::mat4> dynamic_local_;  // per motion: local transform
   std::vector<ObjectId> dynamic_;
   std::vector<ObjectId> moved_;
+  // A static object of `mesh` at `transform`, its bounds and triangles filled.
+  [[nodiscard]] Object make_object(MeshId mesh, MaterialId material, const glm::mat4& transform,
+                                   OccluderClass occluder) const;
   std::vector<Aabb> mesh_bounds_;
   std::vector<double> mesh_area_;
   std::uint64_t mesh_triangles_ = 0;  // sum over meshes_, against caps_

@@ -77,6 +77,12 @@ ObjectId Scene::add_object(MeshId mesh, MaterialId material, const glm::mat4& tr
   if (objects_.size() >= caps_.objects)
     throw InputError(fmt::format("scene {}: more than {} objects, the limit (occull::limits::objects)", name_,
                                  caps_.objects));
+  objects_.push_back(make_object(mesh, material, transform, occluder));
+  return ObjectId(objects_.size() - 1);
+}
+
+Object Scene::make_object(MeshId mesh, MaterialId material, const glm::mat4& transform,
+                          OccluderClass occluder) const {
   Object o;
   o.mesh = mesh;
   o.material = material;
@@ -84,8 +90,7 @@ ObjectId Scene::add_object(MeshId mesh, MaterialId material, const glm::mat4& tr
   o.bounds = transform_box(mesh_bounds_[mesh], transform);
   o.triangles = std::uint32_t(meshes_[mesh].triangle_count());
   o.occluder = occluder;
-  objects_.push_back(o);
-  return ObjectId(objects_.size() - 1);
+  return o;
 }
 
 ObjectId Scene::add_dynamic_object(MeshId mesh, MaterialId material, Motion motion,
@@ -103,13 +108,7 @@ void Scene::place_object(ObjectId id, MeshId mesh, MaterialId material, const gl
                          OccluderClass occluder) {
   assert(id < objects_.size() && !objects_[id].dynamic());
   assert(mesh < meshes_.size() && material < materials_.size());
-  Object& o = objects_[id];
-  o.mesh = mesh;
-  o.material = material;
-  o.transform = transform;
-  o.bounds = transform_box(mesh_bounds_[mesh], transform);
-  o.triangles = std::uint32_t(meshes_[mesh].triangle_count());
-  o.occluder = occluder;
+  objects_[id] = make_object(mesh, material, transform, occluder);
   moved_.push_back(id);
 }
 

@@ -124,6 +124,7 @@ const std::vector<Entry>& registry() {
         {{"local", "chcpp", "culling inside a visible tile: chcpp (its own CHC++ context) or none (draw the whole tile)"},
          {"evict", "60", "frames a tile instance may go unused before its BVH instance and CHC++ context are freed"},
          {"neighbors", "8", "neighbours a visible tile queries: 4 (edges) or 8 (edges and corners)"},
+         {"requery", "1", "a tile found visible is queried again every N frames and drawn without a query in between (1: every frame, as the paper; N > 1 as CHC++ re-queries visible nodes)"},
          {"box", "common", "box a tile query draws: common (the union of every tile's box) or tile (the queried tile's own box: not conservative, seed 004's Figure 7, kept to show why)"}},
         false, SceneKind::tiled},
        &detail::make_tiles},

@@ -37,7 +37,8 @@ class TilesCuller final : public Culler {
                o.get_int("tiles.evict", 60, 1, 1000000)),
         evict_after_(std::uint64_t(o.get_int("tiles.evict", 60, 1, 1000000))),
         neighbors_(o.get_choice("tiles.neighbors", "8", {"4", "8"}) == "8" ? 8 : 4),
-        common_box_(o.get_choice("tiles.box", "common", {"common", "tile"}) == "common") {}
+        common_box_(o.get_choice("tiles.box", "common", {"common", "tile"}) == "common"),
+        requery_(std::uint64_t(o.get_int("tiles.requery", 1, 1, 1000))) {}
 
   FrameStats render_frame(const View& view, Backend& backend) override {
     FrameStats stats;
@@ -78,6 +79,9 @@ class TilesCuller final : public Culler {
   };
 
   CellState& state(TileCoord c) { return cells_[c]; }
+  [[nodiscard]] static std::uint64_t phase(TileCoord c) noexcept {
+    return std::uint64_t(std::uint32_t(c.x) * 73856093u ^ std::uint32_t(c.z) * 19349663u);
+  }
 
   std::optional<TileCoord> closestVisibleTileInFrustum() {
     cells_in_frustum(world_, *view_, false, in_frustum_);
@@ -96,8 +100,12 @@ class TilesCuller final : public Culler {
       const Aabb box = common_box_ ? world_.common_box_at(n) : world_.tile_box_at(n);  // commonBboxAtOffset(n)
       if (view_->frustum.classify(box) == Containment::outside) continue;
       // The eye-inside rule: the near plane may clip the faces of a box
-      // around the camera, so such a box is visible without a query.
-      if (near_eye(box, *view_, near_radius_)) {
+      // around the camera, so such a box is visible without a query. With
+      // tiles.requery=N, a tile seen visible is drawn again without a query
+      // except every N-th frame (phase by cell, as CHC++ jitters its
+      // re-queries), which only ever draws more: conservative.
+      const bool skip = requery_ > 1 && s.visible_for == frame_ && (frame_ + phase(n)) % requery_ != 0;
+      if (skip || near_eye(box, *view_, near_radius_)) {
         pending_.push_back({0, n, false});
         continue;
       }
@@ -159,6 +167,7 @@ class TilesCuller final : public Culler {
   std::uint64_t evict_after_;
   int neighbors_;
   bool common_box_;  // false: each tile's own box (tiles.box=tile, not conservative)
+  std::uint64_t requery_;  // a visible tile's query every this many frames (1: every frame, as the paper)
   std::uint64_t frame_ = 0;
   std::map<TileCoord, CellState> cells_;
   std::deque<Pending> pending_;    // Q: queries in issue order (results come back in order)

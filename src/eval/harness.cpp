@@ -332,7 +332,10 @@ AlgorithmRun Session::run_path(std::string_view name, Culler& culler, const Came
                                int frames, const std::vector<FrameTruth>* truth,
                                const ProgressFn& progress, bool predict) {
   AlgorithmRun run{std::string(name), 0, true, {}, 0};
-  run.frames.reserve(std::size_t(frames));
+  // The frame records are written (and so made resident) before the first
+  // frame: the memory samples then see what the culler, the renderer and
+  // the driver take, not this record growing by a frame's stats each frame.
+  run.frames.assign(std::size_t(frames), FrameStats{});
   MissRuns misses(bundle_.scene.objects().size());
   for (int k = 0; k < frames; ++k) {
     FrameStats s = run_path_frame(culler, path, k, frames, truth);
@@ -343,7 +346,7 @@ AlgorithmRun Session::run_path(std::string_view name, Culler& culler, const Came
         run.first_miss = fmt::format("frame {}: {}", k, describe_object(missed.front()));
       misses.add(missed);
     }
-    run.frames.push_back(s);
+    run.frames[std::size_t(k)] = s;
     if ((k + 1) % kMemorySampleFrames == 0) {
       const MemoryUsage m = memory_usage();
       run.memory.push_back({k + 1, double(m.resident_bytes) / (1 << 20),
