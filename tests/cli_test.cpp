@@ -147,6 +147,35 @@ TEST(Cli, ScenesListsParametersPathsAndCounts) {
     EXPECT_NE(r.output.find(s), std::string::npos) << s;
 }
 
+TEST(Cli, BenchOnATiledWorldRunsItsAlgorithmsAgainstTilevfc) {
+  // No --algo: the tiled-world set, each row against tilevfc.
+  const CliRun r = run("bench --scene tiles_forest:far=120 --path walk10k --fps 30 --size 64x36 --frames 3 "
+                       "--warmup 1 --no-report");
+  ASSERT_EQ(r.code, 0) << r.output;
+  for (const char* row : {"none", "tilevfc", "pertile", "tiles", "tiles:local=none", "oracle"})
+    EXPECT_FALSE(table_row(r.output, row).empty()) << row << r.output;
+  EXPECT_TRUE(table_row(r.output, "vfc").empty());
+  ASSERT_GT(table_row(r.output, "tilevfc").size(), std::size_t(kVsVfc));
+  EXPECT_EQ(table_row(r.output, "tilevfc")[kVsVfc], "1.00");
+  for (const char* text : {"tiled world: 6 tiles in 64 m cells", "t.query", "postponed", "ms/tile",
+                           "verification passed"})
+    EXPECT_NE(r.output.find(text), std::string::npos) << text << r.output;
+}
+
+TEST(Cli, TiledWorldRefusesOtherAlgorithmsAndTooWideViews) {
+  const CliRun vfc = run("bench --scene tiles_city:far=120 --size 64x36 --frames 1 --algo vfc --no-report");
+  EXPECT_EQ(vfc.code, 2) << vfc.output;
+  EXPECT_NE(vfc.output.find("vfc does not run on a tiled world"), std::string::npos) << vfc.output;
+  EXPECT_NE(vfc.output.find("tilevfc, pertile, tiles"), std::string::npos) << vfc.output;
+  const CliRun tiles = run(std::string("bench ") + kTinyCity + " --frames 1 --algo tiles --no-report");
+  EXPECT_EQ(tiles.code, 2) << tiles.output;
+  EXPECT_NE(tiles.output.find("tiles does not run on a scene that is not a tiled world"), std::string::npos)
+      << tiles.output;
+  const CliRun wide = run("bench --scene tiles_city:far=120 --size 96x36 --frames 1 --algo tiles --no-report");
+  EXPECT_EQ(wide.code, 2) << wide.output;
+  EXPECT_NE(wide.output.find("wider than 2:1"), std::string::npos) << wide.output;
+}
+
 TEST(Cli, BenchPrintsATableRowPerAlgorithm) {
   const CliRun r = run(std::string("bench ") + kTinyCity + " --algo none,vfc,oracle --frames 3 --warmup 1 --no-report");
   ASSERT_EQ(r.code, 0) << r.output;

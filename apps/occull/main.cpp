@@ -485,7 +485,7 @@ int cmd_calibrate(const CalibrateArgs& a) {
 struct RenderArgs {
   std::string scene = "city";
   std::string path;
-  std::string algo = "vfc";
+  std::string algo;  // empty: the scene's frustum-culling baseline
   int frame = 0;
   int frames = 100;
   double fps = 0.0;
@@ -516,7 +516,9 @@ int cmd_render(const RenderArgs& a) {
   if (a.frame >= path.frames_that_fit(session.sampling()))
     throw occull::InputError(fmt::format("--frame {} at --fps {} from --start {} s lies past the end of path {} ({:.1f} s)",
                                          a.frame, a.fps, a.start, path.name(), path.duration()));
-  auto culler = occull::make_culler(a.algo, session.index(), options);
+  const std::string algo =
+      a.algo.empty() ? std::string(occull::vfc_baseline(session.bundle().world != nullptr)) : a.algo;
+  auto culler = occull::make_culler(algo, session.index(), options);
   // Run the frames before K too, so cullers with temporal state see the
   // same history they would in a benchmark.
   occull::FrameStats stats;
@@ -526,7 +528,7 @@ int cmd_render(const RenderArgs& a) {
   if (!stbi_write_png(a.out.c_str(), size.width, size.height, 4, pixels.data(), size.width * 4))
     throw occull::InputError(fmt::format("cannot write '{}'", a.out));
   fmt::print("wrote {} ({}x{}): {} / {} frame {} with {}: {} objects, {} triangles drawn\n", a.out,
-             size.width, size.height, a.scene, path.name(), a.frame, a.algo, stats.objects_rendered,
+             size.width, size.height, a.scene, path.name(), a.frame, algo, stats.objects_rendered,
              stats.triangles);
   return 0;
 }
@@ -765,7 +767,7 @@ int main(int argc, char** argv) {
   auto* r = app.add_subcommand("render", "render one frame of a path with an algorithm to a PNG");
   r->add_option("--scene", render.scene, "scene spec name[:key=value,...]")->capture_default_str();
   r->add_option("--path", render.path, "camera path (default: the scene's first), or file:PATH");
-  r->add_option("--algo", render.algo, "algorithm")->capture_default_str();
+  r->add_option("--algo", render.algo, "algorithm (default: vfc, tilevfc on a tiled world)");
   r->add_option("--frame", render.frame, "frame index K (0-based) of --frames along the path")
       ->capture_default_str();
   r->add_option("--frames", render.frames, "frames the path is divided into")->capture_default_str();
