@@ -11,7 +11,8 @@
 //   hybrid: city blocks, forest patches and open squares with a fountain.
 // Paths: `walk10k` drives 10 km down one street at eye height (14 m/s,
 // weaving a little and looking around), `grazing` flies low over the
-// tiling at grazing angles (the paper's worst case), `turn` turns in place
+// tiling, just above its tallest objects, at grazing angles (the paper's
+// worst case), `turn` turns in place
 // at a crossing.
 #include "mesh_builder.hpp"
 #include "scenes_internal.hpp"
@@ -202,7 +203,8 @@ Tile square_tile(Scene& scene, const Materials& m, const Shared& s, Rng& rng, in
   return t;
 }
 
-std::vector<CameraPath> tile_paths(float lane_weave) {
+// `top`: the height of the common box, which the grazing flight skims.
+std::vector<CameraPath> tile_paths(float lane_weave, float top) {
   std::vector<CameraPath> paths;
   {  // walk10k: 10 km down the street along x = 0 (a cell border), towards -Z.
     std::vector<CameraPath::Key> keys;
@@ -216,16 +218,17 @@ std::vector<CameraPath> tile_paths(float lane_weave) {
     paths.emplace_back("walk10k", "drives 10 km down one street at eye height (14 m/s), looking around a little",
                        std::move(keys));
   }
-  {  // grazing: low flight over the tiling, looking at its horizon.
+  {  // grazing: low flight just over the tallest objects, looking at the horizon.
     std::vector<CameraPath::Key> keys;
     const double speed = 30.0, length = 3000.0, step = 50.0;
     for (double d = 0.0; d <= length + 1e-6; d += step) {
       const float f = float(d);
-      const glm::vec3 eye(0.55f * f + 10.0f, 45.0f + 25.0f * std::sin(f / 400.0f), -0.83f * f + 10.0f);
+      const glm::vec3 eye(0.55f * f + 10.0f, top + 18.0f + 12.0f * std::sin(f / 400.0f), -0.83f * f + 10.0f);
       const float pitch = glm::radians(-6.0f - 5.0f * std::sin(f / 260.0f));
       keys.push_back({d / speed, {eye, 0.585f + 0.3f * std::sin(f / 500.0f), pitch}, false});
     }
-    paths.emplace_back("grazing", "flies 3 km low over the tiling (20-70 m up) at grazing angles: the worst case",
+    paths.emplace_back("grazing",
+                       "flies 3 km low over the tiling (6-30 m above its tallest objects) at grazing angles: the worst case",
                        std::move(keys));
   }
   {  // turn: a full turn in place at a crossing of two streets.
@@ -269,7 +272,7 @@ SceneBundle make_tiled(Set set, const std::string& name, const Params& params) {
   bundle.world = std::make_shared<TiledWorld>(scene, kCell, std::move(tiles), seed,
                                               TiledWorld::reach(bundle.lens));
   bundle.world->populate(scene);
-  bundle.paths = tile_paths(set == Set::forest ? 0.8f : 2.0f);
+  bundle.paths = tile_paths(set == Set::forest ? 0.8f : 2.0f, bundle.world->common_box().max.y);
   return bundle;
 }
 
