@@ -17,7 +17,13 @@
 // point of a farther cell crosses the columns of a chain of neighbouring
 // cells (8-neighbours take the chains through corners) inside their common
 // boxes while it runs inside the boxes' height range, so each of those has a
-// visible point too (seed 004, Section III-C). The verifier checks it.
+// visible point too (seed 004, Section III-C); from above the boxes, every
+// box top in the frustum is seen over whatever lies below it. The verifier
+// checks it (and catches tiles.box=tile, which queries each tile's own box).
+//
+// Beyond the paper: the eye-inside rule (a neighbour's box around the eye is
+// visible without a query, which the near plane could clip) and
+// tiles.requery=N (a visible tile's query only every N-th frame).
 #include "cullers.hpp"
 #include "tile_cache.hpp"
 #include "traversal.hpp"
