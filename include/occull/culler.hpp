@@ -79,6 +79,9 @@ struct OptionInfo {
   std::string key;            ///< without the algorithm prefix
   std::string default_value;
   std::string help;
+  /// Any value but the default may cull visible objects (a sample
+  /// threshold, tiles.box=tile): is_conservative() says no for such a run.
+  bool approximate_unless_default = false;
 };
 
 /// What kind of scene an algorithm runs on.
@@ -87,6 +90,7 @@ enum class SceneKind : std::uint8_t {
   tiled,  ///< a tiled world only (SceneIndex::world)
   any,    ///< either
 };
+
 struct AlgorithmInfo {
   std::string name;
   std::string summary;
@@ -125,9 +129,10 @@ struct AlgorithmSpec {
 [[nodiscard]] AlgorithmSpec parse_algorithm_spec(std::string_view spec, const Options& base = {});
 
 /// Whether a run of `spec` must never cull a visible object: its algorithm
-/// is conservative and no option makes it approximate — `threshold` > 0
-/// culls nodes with up to that many visible pixels, and `tiles.box=tile`
-/// queries a tile's own box instead of the common box, so such runs may pop.
+/// is conservative and no option makes it approximate
+/// (OptionInfo::approximate_unless_default) — `threshold` > 0 culls nodes
+/// with up to that many visible pixels, and `tiles.box=tile` queries a
+/// tile's own box instead of the common box, so such runs may pop.
 /// The harness reports misses of a conservative run as failures and those
 /// of any other run as popping.
 [[nodiscard]] bool is_conservative(const AlgorithmSpec& spec);

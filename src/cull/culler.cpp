@@ -28,7 +28,7 @@ const std::vector<Entry>& registry() {
        &detail::make_vfc},
       {{"stopwait", "hierarchical stop-and-wait: query every node in the frustum front to back, wait for each",
         true,
-        {{"threshold", "0", "a node is visible when more samples (pixels) pass"},
+        {{"threshold", "0", "a node is visible when more samples (pixels) pass", true},
          {"virtual_leaf", "0", "subtrees with at most this many triangles count as leaves (0: off)"}}},
        &detail::make_stopwait},
       {{"perobject", "per-object async queries after an occluder pre-pass; visible objects re-tested every N frames (seed 002)",
@@ -36,10 +36,10 @@ const std::vector<Entry>& registry() {
         {{"interval", "5", "MAX_FRAMES_WO_OCCLUSION_TESTING: frames a visible object goes untested"},
          {"render_pending", "on", "draw an object while its query is pending"},
          {"prepass", "on", "draw occluders (class always) first and never test them"},
-         {"threshold", "0", "an object is visible when more samples (pixels) pass"}}},
+         {"threshold", "0", "an object is visible when more samples (pixels) pass", true}}},
        &detail::make_perobject},
       {{"chc", "coherent hierarchical culling (Bittner & Wimmer 2004; seed 000 Listing 8.4.1)", true,
-        {{"threshold", "0", "a node is visible when more samples (pixels) pass"},
+        {{"threshold", "0", "a node is visible when more samples (pixels) pass", true},
          {"skip", "0", "n_av: a visible leaf is assumed visible for n_av frames, queried in frame n_av+1"},
          {"flush_every", "8", "hand queries to the device this many at a time, and poll only those handed over (1: each at once)"},
          {"virtual_leaf", "0", "subtrees with at most this many triangles count as leaves (0: off)"}}},
@@ -56,7 +56,7 @@ const std::vector<Entry>& registry() {
          {"s_max", "1.4", "tight bounds: most total surface area, relative to the node's"},
          {"virtual_leaf", "1500", "subtrees with at most this many triangles count as leaves (0: off)"},
          {"leaf_objects", "0", "... and with at most this many objects (0: any number; 8 cost more queries than it saved on track/lap)"},
-         {"threshold", "0", "a node is visible when more samples (pixels) pass"},
+         {"threshold", "0", "a node is visible when more samples (pixels) pass", true},
          {"pkeep_samples", "20", "tests at persistence i before the measured p_keep(i) replaces the formula"},
          {"seed", "1", "random seed of the jitter"},
          {"flush", "on", "flush the device after each query batch so its results come back sooner"},
@@ -68,7 +68,7 @@ const std::vector<Entry>& registry() {
       {{"nohc", "near optimal hierarchical culling: occlusion probability + calibrated hardware cost model (seed 001)",
         true,
         {{"profile", "(calibrated)", "hardware profile JSON; occull bench calibrates and caches one per renderer"},
-         {"threshold", "0", "a node is visible when more samples (pixels) pass"},
+         {"threshold", "0", "a node is visible when more samples (pixels) pass", true},
          {"fragments_per_pixel", "2", "overdraw assumed when estimating shaded fragments"},
          {"visible_factor", "0.5", "p_occl = factor * p_cov^2 for nodes visible in the last frame"},
          {"levels", "0", "levels the benefit is spread over (0: log2(N_h + 1))"},
@@ -94,7 +94,7 @@ const std::vector<Entry>& registry() {
          {"tight", "on", "query the box of what a cell holds instead of the whole cell"},
          {"latency", "0", "frames before a hidden cell's answer is used: 0 waits for it after the colour pass and draws the cells found visible in the same frame; 1 uses it next frame (the thesis: they pop in a frame late)"},
          {"conditional", "wait", "pre-pass of a cell queried this frame under conditional rendering on its query: wait (the device waits for the result), no_wait (draws while it is unknown) or off"},
-         {"threshold", "0", "a cell is visible when more samples (pixels) pass"},
+         {"threshold", "0", "a cell is visible when more samples (pixels) pass", true},
          {"seed", "1", "random seed of the answers' extra duration when capped"},
          {"split", "reveal", "split screen (bench --views): how the views share the cap; reveal: an even split of what the queries of drawn cells leave, capped at each view's recent peak demand, and what a view does not need lent in proportion to demand x share of its re-queries of hidden cells that found them visible (measured: less popping than even); even: cap / views each"},
          {"split_floor", "1", "with split=reveal: share of an even split of what the queries of drawn cells leave each view is sure of (below 1, more goes by reveal rate)"}}},
@@ -125,7 +125,7 @@ const std::vector<Entry>& registry() {
          {"evict", "60", "frames a tile instance may go unused before its BVH instance and CHC++ context are freed"},
          {"neighbors", "8", "neighbours a visible tile queries: 4 (edges) or 8 (edges and corners)"},
          {"requery", "1", "a tile found visible is queried again every N frames and drawn without a query in between (1: every frame, as the paper; N > 1 as CHC++ re-queries visible nodes)"},
-         {"box", "common", "box a tile query draws: common (the union of every tile's box) or tile (the queried tile's own box: not conservative, seed 004's Figure 7, kept to show why)"}},
+         {"box", "common", "box a tile query draws: common (the union of every tile's box) or tile (the queried tile's own box: not conservative, seed 004's Figure 7, kept to show why)", true}},
         false, SceneKind::tiled},
        &detail::make_tiles},
       {{"oracle",
@@ -294,13 +294,14 @@ AlgorithmSpec parse_algorithm_spec(std::string_view spec, const Options& base) {
 }
 
 bool is_conservative(const AlgorithmSpec& spec) {
-  if (!find_algorithm(spec.name).conservative) return false;
-  const std::string threshold = spec.name + ".threshold";
-  if (spec.options.has(threshold) && spec.options.get_int(threshold, 0, 0, 1 << 24) != 0) return false;
-  // Tile queries over each tile's own box instead of the common box: the
-  // counterexample of seed 004's Figure 7.
-  return !(spec.name == "tiles" && spec.options.has("tiles.box") &&
-           spec.options.get_choice("tiles.box", "common", {"common", "tile"}) == "tile");
+  const AlgorithmInfo& info = find_algorithm(spec.name);
+  if (!info.conservative) return false;
+  for (const OptionInfo& o : info.options) {
+    if (!o.approximate_unless_default) continue;
+    const auto it = spec.options.values().find(spec.name + "." + o.key);
+    if (it != spec.options.values().end() && it->second != o.default_value) return false;
+  }
+  return true;
 }
 
 std::unique_ptr<Culler> make_culler(std::string_view name, const SceneIndex& index,

@@ -80,12 +80,12 @@ const TiledWorld& tiled_world(const SceneIndex& index, std::string_view algorith
   return *index.world;
 }
 
-void cells_in_frustum(const TiledWorld& world, const View& view, bool tile_box, std::vector<TileCoord>& out) {
-  struct Cell {
-    float distance;
-    TileCoord c;
-  };
-  std::vector<Cell> cells;
+namespace {
+
+// Calls visit(cell, distance from the eye to its box) for every cell of the
+// window whose box (the tile's own or the common box) is not outside the frustum.
+template <class Visit>
+void for_cells_in_frustum(const TiledWorld& world, const View& view, bool tile_box, Visit&& visit) {
   const TileCoord centre = world.centre();
   const int r = world.radius();
   for (int dx = -r; dx <= r; ++dx) {
@@ -93,15 +93,39 @@ void cells_in_frustum(const TiledWorld& world, const View& view, bool tile_box, 
       const TileCoord c{centre.x + dx, centre.z + dz};
       const Aabb box = tile_box ? world.tile_box_at(c) : world.common_box_at(c);
       if (view.frustum.classify(box) == Containment::outside) continue;
-      const glm::vec3 nearest = glm::clamp(view.eye, box.min, box.max);
-      cells.push_back({glm::length(nearest - view.eye), c});
+      visit(c, glm::length(glm::clamp(view.eye, box.min, box.max) - view.eye));
     }
   }
-  std::sort(cells.begin(), cells.end(), [](const Cell& a, const Cell& b) {
-    return a.distance < b.distance || (a.distance == b.distance && a.c < b.c);
-  });
+}
+
+// Nearer first; ties by coordinates, so the order is deterministic.
+bool nearer(float da, TileCoord a, float db, TileCoord b) { return da < db || (da == db && a < b); }
+
+}  // namespace
+
+void cells_in_frustum(const TiledWorld& world, const View& view, bool tile_box, std::vector<TileCoord>& out) {
+  struct Cell {
+    float distance;
+    TileCoord c;
+  };
+  std::vector<Cell> cells;
+  for_cells_in_frustum(world, view, tile_box, [&](TileCoord c, float d) { cells.push_back({d, c}); });
+  std::sort(cells.begin(), cells.end(),
+            [](const Cell& a, const Cell& b) { return nearer(a.distance, a.c, b.distance, b.c); });
   out.clear();
   for (const Cell& cell : cells) out.push_back(cell.c);
+}
+
+std::optional<TileCoord> nearest_cell_in_frustum(const TiledWorld& world, const View& view) {
+  std::optional<TileCoord> best;
+  float best_distance = 0.0f;
+  for_cells_in_frustum(world, view, false, [&](TileCoord c, float d) {
+    if (!best || nearer(d, c, best_distance, *best)) {
+      best = c;
+      best_distance = d;
+    }
+  });
+  return best;
 }
 
 }  // namespace occull::detail

@@ -7,6 +7,7 @@
 #include "occull/tiles.hpp"
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 
 namespace occull::detail {
@@ -39,6 +40,7 @@ class TileCache {
   void render(TileInstance& t, const View& view, Backend& backend);
 
   [[nodiscard]] std::size_t size() const noexcept { return cache_.size(); }
+  [[nodiscard]] int evict_after() const noexcept { return evict_after_; }
 
  private:
   SceneIndex index_;
@@ -57,5 +59,7 @@ const TiledWorld& tiled_world(const SceneIndex& index, std::string_view algorith
 /// Cells of the window whose box (`tile_box`: the tile's own, else the
 /// common box) is not outside the frustum, nearest box first.
 void cells_in_frustum(const TiledWorld& world, const View& view, bool tile_box, std::vector<TileCoord>& out);
+/// The first cell cells_in_frustum() would list for the common box, without sorting them all.
+std::optional<TileCoord> nearest_cell_in_frustum(const TiledWorld& world, const View& view);
 
 }  // namespace occull::detail

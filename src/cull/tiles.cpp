@@ -41,7 +41,6 @@ class TilesCuller final : public Culler {
       : world_(tiled_world(index, "tiles")),
         cache_(index, o.get_choice("tiles.local", "chcpp", {"chcpp", "none"}) == "chcpp" ? "chcpp" : "", o,
                o.get_int("tiles.evict", 60, 1, 1000000)),
-        evict_after_(std::uint64_t(o.get_int("tiles.evict", 60, 1, 1000000))),
         neighbors_(o.get_choice("tiles.neighbors", "8", {"4", "8"}) == "8" ? 8 : 4),
         common_box_(o.get_choice("tiles.box", "common", {"common", "tile"}) == "common"),
         requery_(std::uint64_t(o.get_int("tiles.requery", 1, 1, 1000))) {}
@@ -89,11 +88,7 @@ class TilesCuller final : public Culler {
     return std::uint64_t(std::uint32_t(c.x) * 73856093u ^ std::uint32_t(c.z) * 19349663u);
   }
 
-  std::optional<TileCoord> closestVisibleTileInFrustum() {
-    cells_in_frustum(world_, *view_, false, in_frustum_);
-    if (in_frustum_.empty()) return std::nullopt;
-    return in_frustum_.front();
-  }
+  std::optional<TileCoord> closestVisibleTileInFrustum() { return nearest_cell_in_frustum(world_, *view_); }
 
   void queryNeighbors(TileCoord t) {
     static constexpr int kOffsets[8][2] = {{1, 0}, {-1, 0}, {0, 1}, {0, -1}, {1, 1}, {1, -1}, {-1, 1}, {-1, -1}};
@@ -161,7 +156,7 @@ class TilesCuller final : public Culler {
   // long stale) and cells that left the window.
   void prune() {
     for (auto it = cells_.begin(); it != cells_.end();) {
-      if (frame_ - it->second.queried_frame >= evict_after_ || !world_.in_window(it->first))
+      if (frame_ - it->second.queried_frame >= std::uint64_t(cache_.evict_after()) || !world_.in_window(it->first))
         it = cells_.erase(it);
       else
         ++it;
@@ -170,7 +165,6 @@ class TilesCuller final : public Culler {
 
   const TiledWorld& world_;
   TileCache cache_;
-  std::uint64_t evict_after_;
   int neighbors_;
   bool common_box_;  // false: each tile's own box (tiles.box=tile, not conservative)
   std::uint64_t requery_;  // a visible tile's query every this many frames (1: every frame, as the paper)
@@ -179,7 +173,6 @@ class TilesCuller final : public Culler {
   std::deque<Pending> pending_;    // Q: queries in issue order (results come back in order)
   std::vector<Pending> postponed_; // P
   std::vector<QueryId> stale_;     // postponed queries given up on at the last frame's end
-  std::vector<TileCoord> in_frustum_;
   FrameStats* stats_ = nullptr;
   Backend* backend_ = nullptr;
   const View* view_ = nullptr;
