@@ -8,10 +8,12 @@
 // table and report are written first); 5 soak: memory or the query pool
 // grew (the table and JSON are written first).
 #include "occull/culler.hpp"
+#include "occull/debug_view.hpp"
 #include "occull/error.hpp"
 #include "occull/grid.hpp"
 #include "occull/gl/calibrate.hpp"
 #include "occull/gl/context.hpp"
+#include "occull/gl/painter.hpp"
 #include "occull/gl/renderer.hpp"
 #include "occull/process.hpp"
 #include "occull/profile_io.hpp"
@@ -29,6 +31,7 @@
 #include <stb_image_write.h>
 
 #include <algorithm>
+#include <charconv>
 #include <chrono>
 #include <cstdio>
 #include <fstream>
@@ -486,22 +489,60 @@ struct RenderArgs {
   std::string scene = "city";
   std::string path;
   std::string algo;  // empty: the scene's frustum-culling baseline
-  int frame = 0;
+  std::string frame = "0";  // K, or A-B for a numbered sequence
   int frames = 100;
   double fps = 0.0;
   double start = 0.0;
   std::string size = "1280x720";
   std::string out = "occull.png";
+  std::string view = "color";
   std::vector<std::string> opts;
   bool gl_debug = false;
 };
 
+// "K" or "A-B" (inclusive), each in [0, frames).
+std::pair<int, int> parse_frame_range(const std::string& text, int frames) {
+  const auto dash = text.find('-');
+  const auto number = [&](const std::string& part) {
+    int v = 0;
+    const auto [end, ec] = std::from_chars(part.data(), part.data() + part.size(), v);
+    if (part.empty() || ec != std::errc() || end != part.data() + part.size())
+      throw occull::InputError(fmt::format("--frame '{}' is not a frame K or a range A-B", text));
+    return v;
+  };
+  const int first = number(text.substr(0, dash));
+  const int last = dash == std::string::npos ? first : number(text.substr(dash + 1));
+  if (first > last) throw occull::InputError(fmt::format("--frame {}: the range ends before it starts", text));
+  if (first < 0 || last >= frames)
+    throw occull::InputError(fmt::format("--frame {} is outside [0, {}] (--frames {})", text, frames - 1, frames));
+  return {first, last};
+}
+
+// out.png for one frame; out-0012.png for frame 12 of a range.
+std::string numbered(const std::string& out, int frame, bool range) {
+  if (!range) return out;
+  const auto dot = out.rfind('.');
+  const auto slash = out.rfind('/');
+  const bool has_ext = dot != std::string::npos && (slash == std::string::npos || dot > slash);
+  return fmt::format("{}-{:04d}{}", has_ext ? out.substr(0, dot) : out, frame, has_ext ? out.substr(dot) : ".png");
+}
+
+// The views that need an algorithm of one kind refuse the others.
+void check_view_fits(occull::DebugView view, const std::string& algo_spec) {
+  const occull::AlgorithmInfo& info = occull::find_algorithm(occull::parse_algorithm_spec(algo_spec).name);
+  if (view == occull::DebugView::cells && info.name != "grid")
+    throw occull::InputError(fmt::format("--view cells shows the cells of the grid culler (--algo grid), not {}",
+                                         info.name));
+  if (view == occull::DebugView::tiles && info.scenes != occull::SceneKind::tiled)
+    throw occull::InputError(fmt::format(
+        "--view tiles shows tile instances of a tiled-world algorithm (tilevfc, pertile, tiles), not {}", info.name));
+}
+
 int cmd_render(const RenderArgs& a) {
   const Size size = parse_size(a.size);
   if (a.frames < 1) throw occull::InputError("--frames must be at least 1");
-  if (a.frame < 0 || a.frame >= a.frames)
-    throw occull::InputError(fmt::format("--frame {} is outside [0, {}] (--frames {})", a.frame,
-                                         a.frames - 1, a.frames));
+  const auto [first, last] = parse_frame_range(a.frame, a.frames);
+  const occull::DebugView view = occull::parse_debug_view(a.view);
   const occull::Options options = parse_options(a.opts);
   occull::gl::RendererOptions ropts;
   ropts.width = size.width;
@@ -513,23 +554,48 @@ int cmd_render(const RenderArgs& a) {
   occull::Session session(a.scene, ropts, {}, copts);
   session.set_sampling({a.fps, a.start});
   const auto& path = session.path(a.path);
-  if (a.frame >= path.frames_that_fit(session.sampling()))
+  if (last >= path.frames_that_fit(session.sampling()))
     throw occull::InputError(fmt::format("--frame {} at --fps {} from --start {} s lies past the end of path {} ({:.1f} s)",
-                                         a.frame, a.fps, a.start, path.name(), path.duration()));
+                                         last, a.fps, a.start, path.name(), path.duration()));
   const std::string algo =
       a.algo.empty() ? std::string(occull::vfc_baseline(session.bundle().world != nullptr)) : a.algo;
+  check_view_fits(view, algo);
   auto culler = occull::make_culler(algo, session.index(), options);
-  // Run the frames before K too, so cullers with temporal state see the
-  // same history they would in a benchmark.
-  occull::FrameStats stats;
-  for (int k = 0; k <= a.frame; ++k)
-    stats = session.run_frame(*culler, session.view_at(path, k, a.frames), session.frame_time(path, k, a.frames));
-  const auto pixels = session.renderer().read_rgba();
-  if (!stbi_write_png(a.out.c_str(), size.width, size.height, 4, pixels.data(), size.width * 4))
-    throw occull::InputError(fmt::format("cannot write '{}'", a.out));
-  fmt::print("wrote {} ({}x{}): {} / {} frame {} with {}: {} objects, {} triangles drawn\n", a.out,
-             size.width, size.height, a.scene, path.name(), a.frame, algo, stats.objects_rendered,
-             stats.triangles);
+  std::unique_ptr<occull::gl::Painter> painter;
+  if (view != occull::DebugView::color)
+    painter = std::make_unique<occull::gl::Painter>(session.bundle().scene, size.width, size.height);
+  // Run the frames before the first too, so cullers with temporal state see
+  // the same history they would in a benchmark.
+  const bool range = first != last;
+  for (int k = 0; k <= last; ++k) {
+    occull::FrameLog log;
+    const occull::View frame_view = session.view_at(path, k, a.frames);
+    const occull::FrameStats stats =
+        session.run_frame(*culler, frame_view, session.frame_time(path, k, a.frames), k >= first ? &log : nullptr);
+    if (k < first) continue;
+    std::vector<std::uint8_t> pixels = session.renderer().read_rgba();
+    std::string legend;
+    if (painter) {
+      const auto frame_objects = session.renderer().frame_objects();
+      const std::vector<occull::ObjectId> drawn(frame_objects.begin(), frame_objects.end());
+      std::vector<occull::ObjectId> truth;
+      if (view == occull::DebugView::overview)  // the verifier's view: what was missed
+        for (const auto& v : session.truth_at(path, k, a.frames).visible) truth.push_back(v.id);
+      const occull::DebugFrame frame{session.bundle().scene, frame_view, log, culler->regions(), drawn, truth};
+      const occull::Picture picture =
+          occull::make_picture(view, frame, float(size.width) / float(size.height));
+      pixels = painter->paint(picture, pixels);
+      for (const auto& l : picture.legend)
+        legend += fmt::format("\n  {:>6}  {} (rgb {:.2f} {:.2f} {:.2f})", l.count, l.label, l.color.r, l.color.g,
+                              l.color.b);
+    }
+    const std::string file = numbered(a.out, k, range);
+    if (!stbi_write_png(file.c_str(), size.width, size.height, 4, pixels.data(), size.width * 4))
+      throw occull::InputError(fmt::format("cannot write '{}'", file));
+    fmt::print("wrote {} ({}x{}): {} / {} frame {} with {}, view {}: {} objects, {} triangles drawn, {} queries{}\n",
+               file, size.width, size.height, a.scene, path.name(), k, algo, a.view, stats.objects_rendered,
+               stats.triangles, stats.queries, legend);
+  }
   return 0;
 }
 
@@ -764,18 +830,24 @@ int main(int argc, char** argv) {
                 "calibrate twice and report sanity checks (cost ordering, repeatability); writes nothing");
 
   RenderArgs render;
-  auto* r = app.add_subcommand("render", "render one frame of a path with an algorithm to a PNG");
+  auto* r = app.add_subcommand("render", "render a frame of a path with an algorithm to a PNG, as rendered or as a "
+                                          "debug view of what the culler did");
   r->add_option("--scene", render.scene, "scene spec name[:key=value,...]")->capture_default_str();
   r->add_option("--path", render.path, "camera path (default: the scene's first), or file:PATH");
   r->add_option("--algo", render.algo, "algorithm (default: vfc, tilevfc on a tiled world)");
-  r->add_option("--frame", render.frame, "frame index K (0-based) of --frames along the path")
+  r->add_option("--frame", render.frame,
+                "frame index K (0-based) of --frames along the path, or a range A-B: one PNG per frame, "
+                "numbered (out-0012.png)")
       ->capture_default_str();
   r->add_option("--frames", render.frames, "frames the path is divided into")->capture_default_str();
   r->add_option("--fps", render.fps, "frames at this rate of path time instead (0: divide the path)")
       ->capture_default_str();
   r->add_option("--start", render.start, "with --fps: path time of frame 0, seconds")->capture_default_str();
   r->add_option("--size", render.size, "image size WIDTHxHEIGHT")->capture_default_str();
-  r->add_option("--out", render.out, "output PNG file")->capture_default_str();
+  r->add_option("--out,--png", render.out, "output PNG file")->capture_default_str();
+  std::string view_help = "what to draw:";
+  for (const auto& v : occull::debug_views()) view_help += fmt::format(" {}: {};", v.name, v.summary);
+  r->add_option("--view", render.view, view_help)->capture_default_str();
   r->add_option("--opt", render.opts, "algorithm option algo.key=value (repeatable)");
   r->add_flag("--gl-debug", render.gl_debug, kGlDebugHelp);
 

@@ -56,6 +56,13 @@ class Options {
   std::map<std::string, std::string> values_;
 };
 
+/// A region a culler decides visibility for as a whole (a grid cell, a
+/// tile instance), as the debug views show it (occull render --view cells).
+struct CullRegion {
+  Aabb box;      ///< world space
+  bool visible;  ///< drawn in the frame (false: found occluded)
+};
+
 /// Culls and renders one view per call, keeping that view's visibility
 /// state between calls (one instance per view: split screen, shadow views).
 class Culler {
@@ -73,6 +80,14 @@ class Culler {
   /// cullers (`auto`) learn from it; the others ignore it. Without it `auto`
   /// falls back to its own time inside render_frame().
   virtual void frame_finished(const FrameStats& measured) { (void)measured; }
+
+  /// Optional, for the debug views: the regions the last render_frame()
+  /// decided on — `grid`: the occupied cells its traversal met; the
+  /// tiled-world cullers: the tile instances drawn (their tile's box) and,
+  /// for `tiles`, the cells whose tile query came back hidden (the box
+  /// queried). Empty for cullers without such regions. Valid until the
+  /// next render_frame().
+  [[nodiscard]] virtual std::span<const CullRegion> regions() const { return {}; }
 };
 
 struct OptionInfo {

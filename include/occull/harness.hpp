@@ -20,6 +20,7 @@
 #include "occull/bvh.hpp"
 #include "occull/cost_model.hpp"
 #include "occull/culler.hpp"
+#include "occull/frame_log.hpp"
 #include "occull/gl/context.hpp"
 #include "occull/gl/renderer.hpp"
 #include "occull/scenes.hpp"
@@ -149,12 +150,18 @@ class Session {
   /// Runs one frame: moves dynamic objects to `time_s` (untimed), then
   /// times refit, begin_frame, the culler and end_frame (closed by
   /// glFinish). Fills every timing and backend counter of the result.
-  FrameStats run_frame(Culler& culler, const View& view, double time_s);
+  /// With `log`, also logs the culler's backend calls into it (the debug
+  /// views; the log costs time of its own).
+  FrameStats run_frame(Culler& culler, const View& view, double time_s, FrameLog* log = nullptr);
 
   /// The ground truth of frames 0..frames-1 of `path` (untimed), each
   /// frame checked by the truth invariants. Throws InvariantViolation.
   [[nodiscard]] std::vector<FrameTruth> ground_truth(const CameraPath& path, int frames,
                                                      const ProgressFn& progress = {});
+  /// The ground truth of frame k of `frames` along `path` alone (untimed;
+  /// moves the scene to that frame's time), checked as ground_truth()'s.
+  /// Overwrites the renderer's targets.
+  [[nodiscard]] FrameTruth truth_at(const CameraPath& path, int k, int frames);
 
   /// Test hooks (see FaultHooks); empty by default.
   void set_fault_hooks(FaultHooks hooks) { hooks_ = std::move(hooks); }

@@ -106,6 +106,7 @@ class GridCuller final : public Culler {
     bool capped = false;
     std::uint64_t answers = 0, age = 0;
     colour_.clear();
+    regions_.clear();
     for (const CellRun& run : traversal_.traverse(grid_->geometry(), view, config_.traversal)) {
       for (int i = 0; i < run.count; ++i) {
         ++stats.nodes_visited;
@@ -129,6 +130,7 @@ class GridCuller final : public Culler {
           ++answers;
           age += frame_ - cell.asked;
         }
+        regions_.push_back({grid_->geometry().cell_box(grid_->coord(c)), draw});
         QueryId query = 0;
         bool queried = false;
         if (requery) {
@@ -139,7 +141,7 @@ class GridCuller final : public Culler {
           if (queries < cap || draw) {
             query = backend.issue_query(std::span<const Aabb>(&box, 1));
             queried = true;
-            pending_.push_back({query, c, draw, cell.until < frame_});
+            pending_.push_back({query, c, draw, cell.until < frame_, regions_.size() - 1});
             ++queries;
             ++stats.query_batches;
           } else {
@@ -191,6 +193,7 @@ class GridCuller final : public Culler {
     std::uint32_t cell;
     bool drawn;             // the cell's objects were drawn in the frame of the query
     bool overdue;           // its answer had expired before that frame: the cap deferred it
+    std::size_t region;     // its entry in regions_ of that frame
     bool settled = false;   // result read in that frame already (reveal), kept in `visible`
     bool visible = false;
     bool useful = false;    // settled, visible, and it drew an object no other cell had drawn
@@ -209,6 +212,7 @@ class GridCuller final : public Culler {
       p.visible = backend.result(p.query) > config_.threshold;
       if (!p.visible) continue;
       ++stats.revealed;
+      regions_[p.region].visible = true;
       for (ObjectId id : grid_->objects(p.cell)) {
         if (drawn_[id] == frame_) continue;
         drawn_[id] = frame_;
@@ -249,6 +253,8 @@ class GridCuller final : public Culler {
     pending_.clear();
   }
 
+  [[nodiscard]] std::span<const CullRegion> regions() const override { return regions_; }
+
   bool in_one_cell(ObjectId id) const {
     const Aabb& b = scene_.object(id).bounds;
     return grid_->geometry().cell_of(b.min) == grid_->geometry().cell_of(b.max);
@@ -273,6 +279,7 @@ class GridCuller final : public Culler {
   std::vector<std::uint64_t> drawn_;    // per object: last frame it was drawn (once per frame)
   std::vector<Pending> pending_;        // this frame's queries, read next frame
   std::vector<ObjectId> prepass_, inside_, colour_;
+  std::vector<CullRegion> regions_;     // this frame's cells (Culler::regions)
   std::uint64_t frame_ = 0;
   int capped_frames_ = 0;               // consecutive frames that hit the cap
   std::mt19937 rng_;

@@ -26,6 +26,7 @@ class PerTileCuller final : public Culler {
     cache_.end_frame();
     return stats;
   }
+  [[nodiscard]] std::span<const CullRegion> regions() const override { return cache_.regions(); }
 
  private:
   const TiledWorld& world_;

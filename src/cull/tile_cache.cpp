@@ -16,6 +16,7 @@ TileCache::TileCache(const SceneIndex& index, std::string local, const Options& 
 void TileCache::begin_frame(std::uint64_t frame, FrameStats& stats) {
   frame_ = frame;
   stats_ = &stats;
+  regions_.clear();
 }
 
 TileInstance& TileCache::fetch(TileCoord c) {
@@ -44,6 +45,7 @@ TileInstance& TileCache::fetch(TileCoord c) {
 
 void TileCache::render(TileInstance& t, const View& view, Backend& backend) {
   if (stats_) ++stats_->tiles_rendered;
+  note(index_.world->tile_box_at(t.coord), true);
   if (t.local) {
     const FrameStats s = t.local->render_frame(view, backend);
     if (stats_) {

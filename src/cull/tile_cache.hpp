@@ -37,7 +37,12 @@ class TileCache {
   /// last fetch) and records the cache size in the frame's stats.
   void end_frame();
   /// Draws a fetched instance: through its local culler, or all its objects.
+  /// Records its tile's box as a visible region.
   void render(TileInstance& t, const View& view, Backend& backend);
+  /// Records a region of this frame: a cell's box, drawn or found hidden.
+  void note(const Aabb& box, bool visible) { regions_.push_back({box, visible}); }
+  /// This frame's regions (Culler::regions), cleared by begin_frame().
+  [[nodiscard]] std::span<const CullRegion> regions() const noexcept { return regions_; }
 
   [[nodiscard]] std::size_t size() const noexcept { return cache_.size(); }
   [[nodiscard]] int evict_after() const noexcept { return evict_after_; }
@@ -51,6 +56,7 @@ class TileCache {
   std::uint64_t frame_ = 0;
   FrameStats* stats_ = nullptr;
   std::vector<ObjectId> all_;
+  std::vector<CullRegion> regions_;
 };
 
 /// The world of `index`; InputError naming `algorithm` when there is none.

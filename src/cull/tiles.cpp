@@ -71,6 +71,7 @@ class TilesCuller final : public Culler {
     stats_ = nullptr;
     return stats;
   }
+  [[nodiscard]] std::span<const CullRegion> regions() const override { return cache_.regions(); }
 
  private:
   struct CellState {
@@ -81,6 +82,7 @@ class TilesCuller final : public Culler {
     QueryId query;
     TileCoord cell;
     bool queried;  // false: visible by the eye-inside rule, no query issued
+    Aabb box;      // what was queried
   };
 
   CellState& state(TileCoord c) { return cells_[c]; }
@@ -107,10 +109,10 @@ class TilesCuller final : public Culler {
       // re-queries), which only ever draws more: conservative.
       const bool skip = requery_ > 1 && s.visible_for == frame_ && (frame_ + phase(n)) % requery_ != 0;
       if (skip || near_eye(box, *view_, near_radius_)) {
-        pending_.push_back({0, n, false});
+        pending_.push_back({0, n, false, box});
         continue;
       }
-      pending_.push_back({backend_->issue_query(std::span<const Aabb>(&box, 1)), n, true});
+      pending_.push_back({backend_->issue_query(std::span<const Aabb>(&box, 1)), n, true, box});
       ++stats_->tile_queries;
     }
   }
@@ -134,6 +136,7 @@ class TilesCuller final : public Culler {
         return p.cell;
       }
       s.visible_for = 0;
+      cache_.note(p.box, false);
     }
     return std::nullopt;
   }

@@ -26,11 +26,13 @@ class TileVfcCuller final : public Culler {
       TileInstance& t = cache_.fetch(c);
       collect_in_frustum_front_to_back(SceneIndex{index_.scene, *t.bvh, nullptr}, view, queue_, stats);
       ++stats.tiles_rendered;
+      cache_.note(world_.tile_box_at(c), true);
     }
     if (!queue_.empty()) backend.render(queue_);
     cache_.end_frame();
     return stats;
   }
+  [[nodiscard]] std::span<const CullRegion> regions() const override { return cache_.regions(); }
 
  private:
   SceneIndex index_;

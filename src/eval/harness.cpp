@@ -1,5 +1,7 @@
 #include "occull/harness.hpp"
 
+#include "occull/frame_log.hpp"
+
 #include "watchdog.hpp"
 #include "occull/grid_views.hpp"
 
@@ -161,7 +163,7 @@ View Session::view_at(const CameraPath& path, int k, int frames) const {
                    renderer_->height());
 }
 
-FrameStats Session::run_frame(Culler& culler, const View& view, double time_s) {
+FrameStats Session::run_frame(Culler& culler, const View& view, double time_s, FrameLog* log) {
   const auto step = watchdog_->step(fmt::format("a culler's frame at {:.3f} s of the path", time_s));
   bundle_.scene.update(time_s);
   if (bundle_.world) bundle_.world->follow(bundle_.scene, view.eye);
@@ -169,7 +171,9 @@ FrameStats Session::run_frame(Culler& culler, const View& view, double time_s) {
   const auto t0 = Clock::now();
   if (!bundle_.world) bvh_.refit(bundle_.scene);
   renderer_->begin_frame(view);
-  Backend& backend = this->backend();
+  std::optional<LoggingBackend> recorder;
+  if (log) recorder.emplace(this->backend(), *log);
+  Backend& backend = recorder ? static_cast<Backend&>(*recorder) : this->backend();
   const BackendStats before = backend.stats();
   const auto c0 = Clock::now();
   FrameStats s = culler.render_frame(view, backend);
@@ -208,53 +212,54 @@ std::vector<FrameTruth> Session::ground_truth(const CameraPath& path, int frames
                                               const ProgressFn& progress) {
   std::vector<FrameTruth> truth;
   truth.reserve(std::size_t(frames));
-  const Scene& scene = bundle_.scene;
-  const auto objects = scene.objects();
-  std::vector<ObjectId> in_frustum, outside;
-  std::vector<std::uint8_t> drawn(objects.size());
   for (int k = 0; k < frames; ++k) {
-    bundle_.scene.update(frame_time(path, k, frames));
-    const View view = view_at(path, k, frames);
-    const detail::FrameLabel where{scene_spec_, path.name(), k};
-    if (bundle_.world) {
-      bundle_.world->follow(bundle_.scene, view.eye);
-      // The truth sees only the placed cells: the window must hold the frustum.
-      if (!bundle_.world->covers(view))
-        detail::invariant_violated(where, "window-covers-frustum",
-                                   fmt::format("the frustum reaches past the {} x {} cells placed around the eye",
-                                               2 * bundle_.world->radius() + 1, 2 * bundle_.world->radius() + 1));
-    }
-    const auto step = watchdog_->step(fmt::format("ground-truth frame {} of path {}", k, path.name()));
-    in_frustum.clear();
-    for (ObjectId id = 0; id < objects.size(); ++id)
-      if (view.frustum.classify(objects[id].bounds) != Containment::outside) in_frustum.push_back(id);
-    if (hooks_.truth_objects) hooks_.truth_objects(in_frustum);
-
-    FrameTruth t;
-    gl::Renderer::PassImages images;
-    t.visible = renderer_->visible_pixels(view, in_frustum, &images);
-    if (hooks_.truth_images) hooks_.truth_images(t.visible, images);
-    // The full scene, for comparison: every opaque object left out of the
-    // truth pass, drawn over its depth, must not pass a single sample.
-    std::fill(drawn.begin(), drawn.end(), 0);
-    for (ObjectId id : in_frustum) drawn[id] = 1;
-    outside.clear();
-    for (ObjectId id = 0; id < objects.size(); ++id)
-      if (!drawn[id] && !scene.material(objects[id].material).translucent) outside.push_back(id);
-    const std::uint64_t outside_samples = renderer_->samples_in_front(view, outside);
-
-    context_->check("the ground truth");
-    std::sort(in_frustum.begin(), in_frustum.end());
-    detail::check_truth_in_frustum(where, t.visible, in_frustum);
-    detail::check_truth_covers_full_render(where, images.ids, images.depth, outside_samples);
-    detail::check_truth_not_empty(where, t.visible, images.ids, scene);
-    t.probes = std::uint32_t(detail::check_truth_probes(where, scene, view, in_frustum, images.depth,
-                                                         renderer_options_.cull_backfaces));
-    t.coverage = detail::depth_coverage(images.depth);
-    truth.push_back(std::move(t));
+    truth.push_back(truth_at(path, k, frames));
     if (progress) progress("ground truth", k, frames, false);
   }
   return truth;
+}
+
+FrameTruth Session::truth_at(const CameraPath& path, int k, int frames) {
+  const Scene& scene = bundle_.scene;
+  const auto objects = scene.objects();
+  bundle_.scene.update(frame_time(path, k, frames));
+  const View view = view_at(path, k, frames);
+  const detail::FrameLabel where{scene_spec_, path.name(), k};
+  if (bundle_.world) {
+    bundle_.world->follow(bundle_.scene, view.eye);
+    // The truth sees only the placed cells: the window must hold the frustum.
+    if (!bundle_.world->covers(view))
+      detail::invariant_violated(where, "window-covers-frustum",
+                                 fmt::format("the frustum reaches past the {} x {} cells placed around the eye",
+                                             2 * bundle_.world->radius() + 1, 2 * bundle_.world->radius() + 1));
+  }
+  const auto step = watchdog_->step(fmt::format("ground-truth frame {} of path {}", k, path.name()));
+  std::vector<ObjectId> in_frustum, outside;
+  for (ObjectId id = 0; id < objects.size(); ++id)
+    if (view.frustum.classify(objects[id].bounds) != Containment::outside) in_frustum.push_back(id);
+  if (hooks_.truth_objects) hooks_.truth_objects(in_frustum);
+
+  FrameTruth t;
+  gl::Renderer::PassImages images;
+  t.visible = renderer_->visible_pixels(view, in_frustum, &images);
+  if (hooks_.truth_images) hooks_.truth_images(t.visible, images);
+  // The full scene, for comparison: every opaque object left out of the
+  // truth pass, drawn over its depth, must not pass a single sample.
+  std::vector<std::uint8_t> drawn(objects.size(), 0);
+  for (ObjectId id : in_frustum) drawn[id] = 1;
+  for (ObjectId id = 0; id < objects.size(); ++id)
+    if (!drawn[id] && !scene.material(objects[id].material).translucent) outside.push_back(id);
+  const std::uint64_t outside_samples = renderer_->samples_in_front(view, outside);
+
+  context_->check("the ground truth");
+  std::sort(in_frustum.begin(), in_frustum.end());
+  detail::check_truth_in_frustum(where, t.visible, in_frustum);
+  detail::check_truth_covers_full_render(where, images.ids, images.depth, outside_samples);
+  detail::check_truth_not_empty(where, t.visible, images.ids, scene);
+  t.probes = std::uint32_t(detail::check_truth_probes(where, scene, view, in_frustum, images.depth,
+                                                       renderer_options_.cull_backfaces));
+  t.coverage = detail::depth_coverage(images.depth);
+  return t;
 }
 
 std::unique_ptr<Culler> Session::make(std::string_view spec, const Options& options) {

@@ -1,5 +1,6 @@
 #include "gl.hpp"
 
+#include <algorithm>
 #include <stdexcept>
 #include <string>
 
@@ -57,6 +58,32 @@ GLuint make_program(const char* name, const std::string& vertex, const std::stri
     throw std::runtime_error(std::string("linking the ") + name + " program failed: " + log);
   }
   return program;
+}
+
+}  // namespace occull::gl
+
+namespace occull::gl {
+
+void bind_for_reading(GLuint fbo, GLint alignment) {
+  glBindFramebuffer(GL_READ_FRAMEBUFFER, fbo);
+  glBindBuffer(GL_PIXEL_PACK_BUFFER, 0);
+  glPixelStorei(GL_PACK_ALIGNMENT, alignment);
+  glPixelStorei(GL_PACK_ROW_LENGTH, 0);
+  glPixelStorei(GL_PACK_SKIP_ROWS, 0);
+  glPixelStorei(GL_PACK_SKIP_PIXELS, 0);
+}
+
+std::vector<std::uint8_t> read_rgba_top_first(GLuint fbo, int width, int height) {
+  const std::size_t row = std::size_t(width) * 4;
+  std::vector<std::uint8_t> pixels(row * std::size_t(height));
+  glNamedFramebufferReadBuffer(fbo, GL_COLOR_ATTACHMENT0);
+  bind_for_reading(fbo, 1);
+  glReadPixels(0, 0, width, height, GL_RGBA, GL_UNSIGNED_BYTE, pixels.data());
+  check_error("reading the colour buffer");
+  for (int y = 0; y < height / 2; ++y)
+    std::swap_ranges(pixels.begin() + long(std::size_t(y) * row), pixels.begin() + long(std::size_t(y + 1) * row),
+                     pixels.begin() + long(std::size_t(height - 1 - y) * row));
+  return pixels;
 }
 
 }  // namespace occull::gl

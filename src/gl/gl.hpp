@@ -8,7 +8,9 @@
 #include <GL/gl.h>
 #include <GL/glext.h>
 
+#include <cstdint>
 #include <string>
+#include <vector>
 
 namespace occull::gl {
 
@@ -18,5 +20,13 @@ void check_error(const char* where);
 /// Compiles and links a program from vertex and fragment source; throws
 /// std::runtime_error with the info log on failure.
 GLuint make_program(const char* name, const std::string& vertex, const std::string& fragment);
+
+/// State glReadPixels depends on: the framebuffer read from, no pixel-pack
+/// buffer (else it writes into that buffer), tight rows of `alignment`.
+void bind_for_reading(GLuint fbo, GLint alignment);
+
+/// Colour attachment 0 of `fbo` as RGBA8, width*height pixels, top row
+/// first (GL's first row is the bottom one; images start at the top).
+[[nodiscard]] std::vector<std::uint8_t> read_rgba_top_first(GLuint fbo, int width, int height);
 
 }  // namespace occull::gl

@@ -2,6 +2,7 @@
 
 #include "gl.hpp"
 #include "occull/input_limits.hpp"
+#include "scene_mesh.hpp"
 
 #include <glm/gtc/type_ptr.hpp>
 
@@ -178,12 +179,6 @@ const char* kQueryFragment = R"(#version 450 core
 void main() {}
 )";
 
-struct MeshRange {
-  GLsizei index_count = 0;
-  std::size_t first_index = 0;
-  GLint base_vertex = 0;
-};
-
 struct MaterialData {
   glm::vec4 color;  // alpha 1 for opaque materials
   GLint lights = 0;  // shading cost: extra lights evaluated per fragment
@@ -211,17 +206,6 @@ constexpr GLsizeiptr kBoxCapacity = 1 << 16;
 // at a time (see draw_objects).
 constexpr std::size_t kMinMultiDrawRun = 16;
 constexpr QueryId kNoQuery = ~QueryId(0);  // boxes per stream-buffer fill
-
-// State glReadPixels depends on: the framebuffer read from, no pixel-pack
-// buffer (else it writes into that buffer), tight rows.
-void bind_for_reading(GLuint fbo, GLint alignment) {
-  glBindFramebuffer(GL_READ_FRAMEBUFFER, fbo);
-  glBindBuffer(GL_PIXEL_PACK_BUFFER, 0);
-  glPixelStorei(GL_PACK_ALIGNMENT, alignment);
-  glPixelStorei(GL_PACK_ROW_LENGTH, 0);
-  glPixelStorei(GL_PACK_SKIP_ROWS, 0);
-  glPixelStorei(GL_PACK_SKIP_PIXELS, 0);
-}
 
 // The query mesh: the 36 vertices of a unit cube's faces (outward,
 // counter-clockwise; corner i has bit 0 = x, bit 1 = y, bit 2 = z, as
@@ -387,33 +371,12 @@ void Renderer::Impl::apply_draw_buffers() const {
 
 void Renderer::Impl::create_scene_buffers() {
   // One interleaved vertex buffer and one index buffer for every mesh.
-  std::size_t vertex_count = 0, index_count = 0;
-  for (const Mesh& m : scene.meshes()) {
-    vertex_count += m.positions.size();
-    index_count += m.indices.size();
-  }
-  std::vector<float> vertices;
-  vertices.reserve(vertex_count * 6);
-  std::vector<std::uint32_t> indices;
-  indices.reserve(index_count);
-  for (const Mesh& m : scene.meshes()) {
-    MeshRange r;
-    r.index_count = GLsizei(m.indices.size());
-    r.first_index = indices.size();
-    r.base_vertex = GLint(vertices.size() / 6);
-    for (std::size_t i = 0; i < m.positions.size(); ++i) {
-      vertices.insert(vertices.end(), {m.positions[i].x, m.positions[i].y, m.positions[i].z,
-                                       m.normals[i].x, m.normals[i].y, m.normals[i].z});
-    }
-    indices.insert(indices.end(), m.indices.begin(), m.indices.end());
-    meshes.push_back(r);
-  }
-  glCreateBuffers(1, &vertex_buffer);
-  glNamedBufferStorage(vertex_buffer, GLsizeiptr(std::max<std::size_t>(vertices.size(), 1) * 4),
-                       vertices.empty() ? nullptr : vertices.data(), 0);
-  glCreateBuffers(1, &index_buffer);
-  glNamedBufferStorage(index_buffer, GLsizeiptr(std::max<std::size_t>(indices.size(), 1) * 4),
-                       indices.empty() ? nullptr : indices.data(), 0);
+  const SceneMesh mesh = build_scene_mesh(scene);
+  meshes = mesh.ranges;
+  const SceneMeshBuffers buffers = upload_scene_mesh(mesh);
+  vertex_buffer = buffers.vertex_buffer;
+  index_buffer = buffers.index_buffer;
+  scene_vao = buffers.vao;
 
   // Object index per instance: drawing object i with base instance i makes
   // the vertex shader see a_object == i.
@@ -436,14 +399,6 @@ void Renderer::Impl::create_scene_buffers() {
     materials.push_back({color, std::max(0, m.shading_cost)});
   }
 
-  glCreateVertexArrays(1, &scene_vao);
-  glVertexArrayVertexBuffer(scene_vao, 0, vertex_buffer, 0, 6 * sizeof(float));
-  glVertexArrayAttribFormat(scene_vao, 0, 3, GL_FLOAT, GL_FALSE, 0);
-  glVertexArrayAttribFormat(scene_vao, 1, 3, GL_FLOAT, GL_FALSE, 3 * sizeof(float));
-  glVertexArrayAttribBinding(scene_vao, 0, 0);
-  glVertexArrayAttribBinding(scene_vao, 1, 0);
-  glEnableVertexArrayAttrib(scene_vao, 0);
-  glEnableVertexArrayAttrib(scene_vao, 1);
   if (options.multi_draw) {  // the object index of each multi-draw command's instance
     glVertexArrayVertexBuffer(scene_vao, 1, object_index_buffer, 0, sizeof(std::uint32_t));
     glVertexArrayBindingDivisor(scene_vao, 1, 1);
@@ -451,7 +406,6 @@ void Renderer::Impl::create_scene_buffers() {
     glVertexArrayAttribBinding(scene_vao, 2, 1);
     glEnableVertexArrayAttrib(scene_vao, 2);
   }
-  glVertexArrayElementBuffer(scene_vao, index_buffer);
 
   const std::string header = options.multi_draw ? "#version 450 core\n#define OCCULL_MULTI_DRAW 1\n"
                                                  : "#version 450 core\n";
@@ -944,18 +898,7 @@ std::vector<std::uint32_t> Renderer::read_ids() const {
 
 std::vector<std::uint8_t> Renderer::read_rgba() const {
   const Impl& g = *impl_;
-  const std::size_t row = std::size_t(g.options.width) * 4;
-  std::vector<std::uint8_t> pixels(row * std::size_t(g.options.height));
-  glNamedFramebufferReadBuffer(g.fbo, GL_COLOR_ATTACHMENT0);
-  bind_for_reading(g.fbo, 1);
-  glReadPixels(0, 0, g.options.width, g.options.height, GL_RGBA, GL_UNSIGNED_BYTE, pixels.data());
-  check_error("reading the colour buffer");
-  // GL's first row is the bottom one; images start at the top.
-  for (int y = 0; y < g.options.height / 2; ++y)
-    std::swap_ranges(pixels.begin() + long(std::size_t(y) * row),
-                     pixels.begin() + long(std::size_t(y + 1) * row),
-                     pixels.begin() + long(std::size_t(g.options.height - 1 - y) * row));
-  return pixels;
+  return read_rgba_top_first(g.fbo, g.options.width, g.options.height);
 }
 
 std::span<const ObjectId> Renderer::frame_objects() const noexcept { return impl_->frame_objects; }
