@@ -63,7 +63,7 @@ TEST(Cli, HelpOnEveryCommandNamesItsOptions) {
                  "--suite", "--malloc", "--views", "--gl-debug", "--stall-guard", "--watchdog"}},
       {"calibrate", {"--size", "--repeats", "--out", "--check"}},
       {"sweep", {"--algo", "--vary", "--baseline", "--popping", "--longest", "--scene", "--frames", "--json"}},
-      {"render", {"--scene", "--frame", "--fps", "--out", "--gl-debug"}},
+      {"render", {"--scene", "--frame", "--fps", "--out", "--png", "--view", "overview", "--gl-debug"}},
       {"traverse", {"--dims", "--views", "--mode", "--fov", "--seed"}},
       {"soak", {"--scene", "--path", "--algo", "--frames", "--window", "--warmup", "--fps", "--size", "--json",
                 "--gl-debug", "--stall-guard", "--watchdog"}}};
@@ -196,6 +196,38 @@ TEST(Cli, RenderWritesAPngAndSaysWhatItDrew) {
   char magic[8] = {};
   f.read(magic, 8);
   EXPECT_EQ(std::string(magic + 1, 3), "PNG");
+}
+
+TEST(Cli, RenderDebugViewWritesANumberedSequenceAndItsLegend) {
+  const std::string out = ::testing::TempDir() + "occull_cli_view.png";
+  const auto numbered = [&](int k) { return ::testing::TempDir() + "occull_cli_view-000" + std::to_string(k) + ".png"; };
+  for (int k = 1; k <= 4; ++k) std::remove(numbered(k).c_str());
+  const CliRun r =
+      run(std::string("render ") + kTinyCity + " --algo chc --view queries --frame 2-4 --frames 5 --png " + out);
+  ASSERT_EQ(r.code, 0) << r.output;
+  for (int k = 2; k <= 4; ++k) {
+    EXPECT_TRUE(std::filesystem::exists(numbered(k))) << numbered(k);
+    EXPECT_NE(r.output.find("wrote " + numbered(k)), std::string::npos) << r.output;
+  }
+  EXPECT_FALSE(std::filesystem::exists(numbered(1)));
+  EXPECT_NE(r.output.find("view queries"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("occluded"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("wasted"), std::string::npos) << r.output;
+}
+
+TEST(Cli, RenderRefusesAViewTheAlgorithmHasNot) {
+  CliRun r = run(std::string("render ") + kTinyCity + " --algo chc --view cells --out /dev/null");
+  EXPECT_EQ(r.code, 2) << r.output;
+  EXPECT_NE(r.output.find("--algo grid"), std::string::npos) << r.output;
+  r = run(std::string("render ") + kTinyCity + " --algo grid --view tiles --out /dev/null");
+  EXPECT_EQ(r.code, 2) << r.output;
+  EXPECT_NE(r.output.find("tilevfc, pertile, tiles"), std::string::npos) << r.output;
+  r = run(std::string("render ") + kTinyCity + " --view wireframe --out /dev/null");
+  EXPECT_EQ(r.code, 2) << r.output;
+  EXPECT_NE(r.output.find("valid: color, queries"), std::string::npos) << r.output;
+  r = run(std::string("render ") + kTinyCity + " --frame 3-1 --out /dev/null");
+  EXPECT_EQ(r.code, 2) << r.output;
+  EXPECT_NE(r.output.find("ends before it starts"), std::string::npos) << r.output;
 }
 
 TEST(Cli, MissingEglDriverExitsThreeWithAnInstallHint) {
