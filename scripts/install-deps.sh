@@ -13,6 +13,8 @@ packages=(
   # libraries
   libglm-dev libfmt-dev libcli11-dev nlohmann-json3-dev libstb-dev libtinyxml2-dev
   libminizip-dev libassimp-dev
+  # occull view: a window (GLFW) with Dear ImGui; tested under a virtual X server
+  libglfw3-dev libimgui-dev xvfb xauth
   # tests and benchmarks
   libgtest-dev libgmock-dev libbenchmark-dev
 )

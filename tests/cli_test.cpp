@@ -1,6 +1,7 @@
 // Runs the occull tool and checks exit codes and messages.
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
+#include <stb_image.h>
 
 #include <array>
 #include <filesystem>
@@ -641,4 +642,84 @@ TEST(Cli, TheExitCodesOfTheReadmeAreTheOnesTheHelpAndTheToolUse) {
   // (Verdict.MissesOfConservativeRunsFailThoseOfOthersArePopping).
   EXPECT_EQ(run("algos").code, 0);
   EXPECT_EQ(run("bench --scene nope").code, 2);
+}
+
+// occull view under a virtual X server (xvfb-run, installed by make test's set-up).
+namespace {
+
+std::vector<std::uint8_t> read_png(const std::string& file, int& w, int& h) {
+  int n = 0;
+  unsigned char* p = stbi_load(file.c_str(), &w, &h, &n, 4);
+  if (!p) return {};
+  std::vector<std::uint8_t> rgba(p, p + std::size_t(w) * std::size_t(h) * 4);
+  stbi_image_free(p);
+  return rgba;
+}
+
+CliRun run_viewer(const std::string& args) {
+  return run("view " + args, "xvfb-run -a -s '-screen 0 640x480x24'");
+}
+
+constexpr const char* kViewScene = "--scene city:blocks=3,traffic=3 --size 160x90";
+
+}  // namespace
+
+TEST(Viewer, ShowsTheQueriesViewOfAFrameAsRenderDrawsIt) {
+  const std::string dir = ::testing::TempDir();
+  const std::string shot = dir + "occull_view_queries.png", rendered = dir + "occull_render_queries.png";
+  std::remove(shot.c_str());
+  // stop-and-wait: no decision depends on when a result arrives, so both runs draw the same frame.
+  CliRun r = run_viewer(std::string(kViewScene) +
+                        " --algo stopwait --view queries --verify --frames 10 --fps 30 --no-ui --screenshot " + shot);
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("flew 10 frames"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("missed 0 of"), std::string::npos) << r.output;
+  r = run(std::string("render ") + kViewScene +
+          " --algo stopwait --view queries --fps 30 --frame 9 --frames 10 --png " + rendered);
+  ASSERT_EQ(r.code, 0) << r.output;
+  int w = 0, h = 0, w2 = 0, h2 = 0;
+  const auto a = read_png(shot, w, h), b = read_png(rendered, w2, h2);
+  ASSERT_EQ(w, 160);
+  ASSERT_EQ(h, 90);
+  ASSERT_EQ(a.size(), b.size());
+  EXPECT_TRUE(a == b) << "the viewer's window differs from render --view queries";
+  // And it shows occluded queries: pixels in a shade of the occluded colour (0.85, 0.15, 0.15).
+  std::size_t red = 0;
+  for (std::size_t i = 0; i < a.size(); i += 4) red += a[i] > 100 && a[i] > 4 * a[i + 1] && a[i + 1] == a[i + 2];
+  EXPECT_GT(red, 100u);
+}
+
+TEST(Viewer, WithItsPanelTheViewStillShowsAroundIt) {
+  const std::string shot = ::testing::TempDir() + "occull_view_panel.png";
+  const CliRun r = run_viewer("--scene city:blocks=3,traffic=3 --size 640x360 --algo grid --view cells --frames 3 "
+                              "--screenshot " + shot);
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("cells drawn"), std::string::npos) << r.output;
+  int w = 0, h = 0;
+  const auto a = read_png(shot, w, h);
+  ASSERT_EQ(w, 640);
+  // Green (drawn) cells right of the panel (250 px wide at x = 8).
+  std::size_t green = 0;
+  for (int y = 0; y < h; ++y)
+    for (int x = 300; x < w; ++x) {
+      const std::size_t i = (std::size_t(y) * std::size_t(w) + std::size_t(x)) * 4;
+      green += a[i + 1] > 100 && a[i + 1] > 2 * a[i] && a[i + 1] > 2 * a[i + 2];
+    }
+  EXPECT_GT(green, 100u);
+}
+
+TEST(Viewer, RecordsTheFlightAsAPathBenchReplays) {
+  const std::string file = ::testing::TempDir() + "occull_flight.path";
+  std::remove(file.c_str());
+  CliRun r = run_viewer(std::string(kViewScene) + " --frames 5 --no-ui --record " + file);
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("wrote " + file + " (5 keys"), std::string::npos) << r.output;
+  r = run(std::string("bench ") + kViewScene + " --algo vfc --frames 5 --path file:" + file);
+  EXPECT_EQ(r.code, 0) << r.output;
+}
+
+TEST(Viewer, RefusesAViewItsAlgorithmHasNot) {
+  const CliRun r = run_viewer(std::string(kViewScene) + " --algo chc --view cells --frames 1");
+  EXPECT_EQ(r.code, 2) << r.output;
+  EXPECT_NE(r.output.find("cells: grid"), std::string::npos) << r.output;
 }

@@ -159,8 +159,11 @@ TEST(DebugView, RegionsAreGreenWhenDrawnAndRedWhenHidden) {
   const DebugFrame f{s, v, log, regions, {}, {}};
   const Picture p = make_picture(DebugView::cells, f, 1.0f);
   ASSERT_EQ(p.boxes.size(), 2u);
-  EXPECT_EQ(p.boxes[0].color, palette::visible);  // sorted by layer: hidden ones over drawn ones
-  EXPECT_EQ(p.boxes[1].color, palette::occluded);
+  EXPECT_EQ(p.boxes[0].color, palette::occluded);
+  EXPECT_EQ(p.boxes[1].color, palette::visible);
+  EXPECT_EQ(p.boxes[0].layer, p.boxes[1].layer);  // depth-tested together: nearer covers farther
+  EXPECT_EQ(p.legend.at(0).count, 1u);
+  EXPECT_EQ(p.legend.at(1).count, 1u);
 }
 
 TEST(DebugView, UnknownViewNamesListTheValidOnes) {

@@ -25,6 +25,7 @@
 #include "occull/soak.hpp"
 #include "occull/suite.hpp"
 #include "occull/sweep.hpp"
+#include "viewer.hpp"
 
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
@@ -851,6 +852,32 @@ int main(int argc, char** argv) {
   r->add_option("--opt", render.opts, "algorithm option algo.key=value (repeatable)");
   r->add_flag("--gl-debug", render.gl_debug, kGlDebugHelp);
 
+  occull::app::ViewArgs view_args;
+  std::string view_size;
+  auto* vw = app.add_subcommand("view",
+                                "a window onto a scene and a culler: fly the camera, switch algorithms, options "
+                                "and debug views, verify live, record the flight (needs a display; xvfb-run "
+                                "without one)");
+  vw->add_option("--scene", view_args.scene, "scene spec name[:key=value,...]")->capture_default_str();
+  vw->add_option("--path", view_args.path, "the path whose start is the first pose; with --frames, the path flown");
+  vw->add_option("--algo", view_args.algo, "algorithm at the start (default: vfc, tilevfc on a tiled world)");
+  vw->add_option("--opt", view_args.opts, "option of that algorithm algo.key=value (repeatable)");
+  vw->add_option("--view", view_args.view, view_help)->capture_default_str();
+  vw->add_option("--size", view_size,
+                 "window size WIDTHxHEIGHT (default: 640x360 on llvmpipe, which is too slow for more; the "
+                 "display's size on a GPU)");
+  vw->add_flag("--verify", view_args.verify, "ground truth every frame: misses in red, counted in the panel");
+  vw->add_option("--frames", view_args.frames,
+                 "scripted: fly --path for this many frames, then exit (tests, recordings); 0: interactive")
+      ->capture_default_str();
+  vw->add_option("--fps", view_args.fps, "scripted: frames at this rate of path time (0: spread over the path)")
+      ->capture_default_str();
+  vw->add_option("--screenshot", view_args.screenshot, "scripted: write the last frame's window to this PNG");
+  vw->add_option("--record", view_args.record,
+                 "record the flight from the start and write it to this path file at the end "
+                 "(bench --path file:FILE replays it)");
+  vw->add_flag("--no-ui", view_args.no_ui, "no panel over the view");
+
   SoakArgs soak;
   auto* so = app.add_subcommand("soak",
                                 "loop a walk for many frames per culler and report memory, GL objects and frame "
@@ -919,6 +946,20 @@ int main(int argc, char** argv) {
     if (cmd == "calibrate") return cmd_calibrate(calibrate);
     if (cmd == "traverse") return cmd_traverse(traverse);
     if (cmd == "soak") return cmd_soak(soak);
+    if (cmd == "view") {
+      if (!view_size.empty()) {
+        const Size size = parse_size(view_size);
+        view_args.width = size.width;
+        view_args.height = size.height;
+      }
+#ifdef OCCULL_VIEWER
+      return occull::app::run_viewer(view_args);
+#else
+      std::cerr << "occull: this occull was built without its viewer: it needs GLFW and Dear ImGui "
+                   "(apt-get install libglfw3-dev libimgui-dev, then make build)\n";
+      return kExitNoGl;
+#endif
+    }
   } catch (const occull::InputError& e) {
     std::cerr << "occull: " << e.what() << "\n";
     return kExitInput;

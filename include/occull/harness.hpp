@@ -38,7 +38,8 @@
 namespace occull {
 
 namespace detail {
-class Watchdog;  // src/eval/watchdog.hpp
+class Watchdog;    // src/eval/watchdog.hpp
+struct FrameLabel;  // src/eval/invariants.hpp
 }  // namespace detail
 
 /// Where opaque geometry covers an image: one bit per pixel (row-major,
@@ -162,6 +163,9 @@ class Session {
   /// moves the scene to that frame's time), checked as ground_truth()'s.
   /// Overwrites the renderer's targets.
   [[nodiscard]] FrameTruth truth_at(const CameraPath& path, int k, int frames);
+  /// The ground truth of `view` over the scene as it stands (a free camera:
+  /// occull view), checked as ground_truth()'s. Overwrites the renderer's targets.
+  [[nodiscard]] FrameTruth truth_of(const View& view);
 
   /// Test hooks (see FaultHooks); empty by default.
   void set_fault_hooks(FaultHooks hooks) { hooks_ = std::move(hooks); }
@@ -243,6 +247,7 @@ class Session {
   [[nodiscard]] const SceneBundle& bundle() const noexcept { return bundle_; }
   [[nodiscard]] SceneIndex index() const noexcept { return {bundle_.scene, bvh_, bundle_.world.get()}; }
   [[nodiscard]] gl::Renderer& renderer() noexcept { return *renderer_; }
+  [[nodiscard]] gl::Context& context() noexcept { return *context_; }
   [[nodiscard]] const gl::DeviceInfo& device() const noexcept { return device_; }
   [[nodiscard]] double scene_build_ms() const noexcept { return scene_build_ms_; }
   [[nodiscard]] double bvh_build_ms() const noexcept { return bvh_build_ms_; }
@@ -265,6 +270,7 @@ class Session {
   std::unique_ptr<detail::Watchdog> watchdog_;
   std::optional<HardwareProfile> profile_;
   FaultHooks hooks_;
+  FrameTruth truth_of(const View& view, const detail::FrameLabel& where);
   FrameSampling sampling_;
 };
 

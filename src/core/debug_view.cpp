@@ -130,11 +130,10 @@ Picture regions_picture(const DebugFrame& f, std::string_view what) {
   Picture p = over_frame(f);
   std::size_t shown = 0, hidden = 0;
   for (const CullRegion& r : f.regions) {
-    p.boxes.push_back({r.box, r.visible ? palette::visible : palette::occluded, std::uint8_t(r.visible ? 0 : 1)});
+    // One layer: nearer regions cover farther ones, as in the thesis' Figure 4.2.
+    p.boxes.push_back({r.box, r.visible ? palette::visible : palette::occluded, 0});
     ++(r.visible ? shown : hidden);
   }
-  std::stable_sort(p.boxes.begin(), p.boxes.end(),
-                   [](const Picture::Box& a, const Picture::Box& b) { return a.layer < b.layer; });
   p.legend.push_back({fmt::format("{} drawn", what), palette::visible, shown});
   p.legend.push_back({fmt::format("{} hidden", what), palette::occluded, hidden});
   return p;

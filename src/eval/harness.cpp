@@ -220,8 +220,6 @@ std::vector<FrameTruth> Session::ground_truth(const CameraPath& path, int frames
 }
 
 FrameTruth Session::truth_at(const CameraPath& path, int k, int frames) {
-  const Scene& scene = bundle_.scene;
-  const auto objects = scene.objects();
   bundle_.scene.update(frame_time(path, k, frames));
   const View view = view_at(path, k, frames);
   const detail::FrameLabel where{scene_spec_, path.name(), k};
@@ -233,7 +231,15 @@ FrameTruth Session::truth_at(const CameraPath& path, int k, int frames) {
                                  fmt::format("the frustum reaches past the {} x {} cells placed around the eye",
                                              2 * bundle_.world->radius() + 1, 2 * bundle_.world->radius() + 1));
   }
-  const auto step = watchdog_->step(fmt::format("ground-truth frame {} of path {}", k, path.name()));
+  return truth_of(view, where);
+}
+
+FrameTruth Session::truth_of(const View& view) { return truth_of(view, {scene_spec_, "(free camera)", 0}); }
+
+FrameTruth Session::truth_of(const View& view, const detail::FrameLabel& where) {
+  const Scene& scene = bundle_.scene;
+  const auto objects = scene.objects();
+  const auto step = watchdog_->step(fmt::format("ground-truth frame {} of path {}", where.frame, where.path));
   std::vector<ObjectId> in_frustum, outside;
   for (ObjectId id = 0; id < objects.size(); ++id)
     if (view.frustum.classify(objects[id].bounds) != Containment::outside) in_frustum.push_back(id);

@@ -173,6 +173,13 @@ void Context::check(std::string_view where) {
   throw GlError(text);
 }
 
+void Context::make_current() {
+  if (!eglMakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, context_))
+    throw GlUnavailable(fmt::format("cannot make occull's context current again (EGL error 0x{:x})", eglGetError()));
+}
+
+void Context::release() { eglMakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT); }
+
 Context::~Context() {
   if (display_) {
     if (eglGetCurrentContext() == context_) glFinish();  // no work in flight when the context goes

@@ -51,6 +51,14 @@ class Context {
 
   [[nodiscard]] DeviceInfo info() const;
 
+  /// Makes this context current on the calling thread again, after other
+  /// GL code (a window's context: occull view) had its own current. Throws
+  /// GlUnavailable if EGL refuses.
+  void make_current();
+  /// Leaves the calling thread without a current EGL context, so another
+  /// API's (GLX) may be made current.
+  void release();
+
   /// Whether the driver reports failing calls (ContextOptions::debug).
   [[nodiscard]] bool debug() const noexcept { return debug_; }
   /// Throws GlError if a GL call on this context failed since the last
