@@ -216,6 +216,14 @@ TEST(Cli, RenderDebugViewWritesANumberedSequenceAndItsLegend) {
   EXPECT_NE(r.output.find("wasted"), std::string::npos) << r.output;
 }
 
+TEST(Cli, RenderShowsTheGridsCellsAndEndsCleanly) {
+  // The grid culler reads its last queries when it goes: through the
+  // session's logger, which must still be there (it was not: a crash).
+  const CliRun r = run(std::string("render ") + kTinyCity + " --algo grid --view cells --frame 3 --frames 5 --out /dev/null");
+  EXPECT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("cells drawn"), std::string::npos) << r.output;
+}
+
 TEST(Cli, RenderRefusesAViewTheAlgorithmHasNot) {
   CliRun r = run(std::string("render ") + kTinyCity + " --algo chc --view cells --out /dev/null");
   EXPECT_EQ(r.code, 2) << r.output;

@@ -29,7 +29,8 @@ TEST(FrameLog, LogsCallsInOrderWithAnswersAndConditionalDraws) {
   inner.conditional = true;
   inner.visible_samples = [](std::span<const Aabb>) { return std::uint64_t(7); };
   FrameLog log;
-  LoggingBackend b(inner, log);
+  LoggingBackend b(inner);
+  b.log_into(&log);
   const ObjectId first[] = {0, 1};
   b.render(first);
   const Aabb box{{0, 0, 0}, {1, 1, 1}};
@@ -57,10 +58,29 @@ TEST(FrameLog, AQueryOfAnEarlierFrameIsForwardedButNotLogged) {
   const Aabb box{{0, 0, 0}, {1, 1, 1}};
   const QueryId old = inner.issue_query(std::span<const Aabb>(&box, 1));
   FrameLog log;
-  LoggingBackend b(inner, log);
+  LoggingBackend b(inner);
+  b.log_into(&log);
   EXPECT_EQ(b.result(old), 1u);
   EXPECT_TRUE(log.queries.empty());
   EXPECT_EQ(inner.read, (std::vector<QueryId>{old}));
+}
+
+TEST(FrameLog, WithoutALogItOnlyForwardsAndANewLogStartsEmpty) {
+  test::RecordingBackend inner;
+  LoggingBackend b(inner);
+  const Aabb box{{0, 0, 0}, {1, 1, 1}};
+  const QueryId q = b.issue_query(std::span<const Aabb>(&box, 1));  // not logged
+  FrameLog log;
+  b.log_into(&log);
+  EXPECT_EQ(b.result(q), 1u);
+  const ObjectId one[] = {1};
+  b.render(one);
+  EXPECT_TRUE(log.queries.empty());
+  ASSERT_EQ(log.draws.size(), 1u);
+  b.log_into(nullptr);
+  b.render(one);
+  EXPECT_EQ(log.draws.size(), 1u);
+  EXPECT_EQ(inner.rendered, (std::vector<ObjectId>{1, 1}));
 }
 
 TEST(DebugView, QueryOutcomesFollowTheOrderOfAnswersAndDraws) {
@@ -151,7 +171,7 @@ TEST(DebugView, OverviewColoursEachObjectByWhatHappenedToIt) {
   EXPECT_EQ(p.lines.size(), 12u);      // the frustum's edges
 }
 
-TEST(DebugView, RegionsAreGreenWhenDrawnAndRedWhenHidden) {
+TEST(DebugView, RegionsAreFootprintsFromAboveGreenWhenDrawnOverRedWhenHidden) {
   const Scene s = three_boxes();
   const View v = front_view();
   const FrameLog log;
@@ -161,7 +181,9 @@ TEST(DebugView, RegionsAreGreenWhenDrawnAndRedWhenHidden) {
   ASSERT_EQ(p.boxes.size(), 2u);
   EXPECT_EQ(p.boxes[0].color, palette::occluded);
   EXPECT_EQ(p.boxes[1].color, palette::visible);
-  EXPECT_EQ(p.boxes[0].layer, p.boxes[1].layer);  // depth-tested together: nearer covers farther
+  EXPECT_LT(p.boxes[0].layer, p.boxes[1].layer);  // drawn over hidden
+  EXPECT_EQ(p.boxes[0].box.min.y, p.boxes[0].box.max.y);  // footprints, seen from above
+  EXPECT_FALSE(p.frame_background);
   EXPECT_EQ(p.legend.at(0).count, 1u);
   EXPECT_EQ(p.legend.at(1).count, 1u);
 }

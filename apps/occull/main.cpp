@@ -4,7 +4,7 @@
 // Exit codes: 0 success; 1 unexpected internal error (also a violated
 // run-time invariant of the instrument); 2 bad input (unknown name, invalid
 // number, bad option, corrupt file); 3 no usable OpenGL 4.5 (EGL or driver
-// missing); 4 bench: a conservative algorithm missed a visible object (the
+// missing; view: no display or no viewer built); 4 bench: a conservative algorithm missed a visible object (the
 // table and report are written first); 5 soak: memory or the query pool
 // grew (the table and JSON are written first).
 #include "occull/culler.hpp"
@@ -751,7 +751,7 @@ int cmd_traverse(const TraverseArgs& a) {
 int main(int argc, char** argv) {
   CLI::App app{"occull — occlusion culling with hardware occlusion queries, and the instrument "
                "that measures it.\n\nExit codes: 0 success, 1 internal error (or a violated invariant of the "
-               "instrument), 2 bad input, 3 no usable OpenGL 4.5, 4 a conservative algorithm missed a "
+               "instrument), 2 bad input, 3 no usable OpenGL 4.5 (view: no display), 4 a conservative algorithm missed a "
                "visible object (bench), 5 memory or the query pool grew (soak)."};
   app.require_subcommand(1);
 

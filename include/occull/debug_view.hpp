@@ -27,8 +27,8 @@ enum class DebugView : std::uint8_t {
   multiqueries,  ///< one colour per query of several boxes (CHC++ Figure 8.4.6)
   batches,       ///< draws and queries coloured by state-change batch, in order (CHC++ Figure 8.4.2)
   overview,      ///< bird's-eye view: frustum; drawn, frustum-culled, occlusion-culled, missed objects
-  cells,         ///< grid cells met, drawn (green) or hidden (red) (thesis Figure 4.2); `grid` only
-  tiles,         ///< tile instances drawn (green), cells found hidden (red); tiled-world cullers only
+  cells,         ///< from above: grid cells met, drawn (green) over hidden (red), and the frustum (thesis Figure 4.2); `grid` only
+  tiles,         ///< from above: tile instances drawn (green) over cells found hidden (red); tiled-world cullers only
 };
 
 struct DebugViewInfo {

@@ -32,14 +32,24 @@ struct FrameLog {
   std::uint64_t events = 0;  ///< calls logged
 };
 
-/// A Backend that forwards every call to another and logs it into a
-/// FrameLog: make one per frame, around the backend the culler renders
-/// through. Stats are the wrapped backend's. Queries issued before it was
-/// made (an earlier frame's) are forwarded but not logged.
-/// Preconditions: `inner` and `log` outlive this object.
+/// A Backend that forwards every call to another and, while given a log,
+/// logs the calls into it. Stats are the wrapped backend's. Queries issued
+/// before the current log was given are forwarded but not logged.
+///
+/// Keep one for as long as the cullers that render through it (a culler may
+/// read its last frame's queries through the last backend it was given,
+/// e.g. when it is destroyed), and switch logs per frame with log_into().
+/// Precondition: `inner` outlives this object.
 class LoggingBackend final : public Backend {
  public:
-  LoggingBackend(Backend& inner, FrameLog& log) : inner_(inner), log_(log) {}
+  explicit LoggingBackend(Backend& inner) : inner_(inner) {}
+
+  /// Logs the calls from now on into `log` (null: none); `log` must stay
+  /// valid until the next log_into().
+  void log_into(FrameLog* log) {
+    log_ = log;
+    in_flight_.clear();
+  }
 
   void render(std::span<const ObjectId> objects) override;
   QueryId issue_query(std::span<const Aabb> boxes) override;
@@ -51,14 +61,14 @@ class LoggingBackend final : public Backend {
   [[nodiscard]] BackendStats stats() const override { return inner_.stats(); }
 
  private:
-  // The log's index of in-flight query q (-1: issued before this backend).
+  // The log's index of in-flight query q (-1: not logged).
   [[nodiscard]] std::int64_t logged(QueryId q) const;
 
   Backend& inner_;
-  FrameLog& log_;
+  FrameLog* log_ = nullptr;
   struct InFlight {
     QueryId id;
-    std::size_t index;  // in log_.queries
+    std::size_t index;  // in log_->queries
   };
   std::vector<InFlight> in_flight_;
 };

@@ -152,7 +152,10 @@ class Session {
   /// times refit, begin_frame, the culler and end_frame (closed by
   /// glFinish). Fills every timing and backend counter of the result.
   /// With `log`, also logs the culler's backend calls into it (the debug
-  /// views; the log costs time of its own).
+  /// views; the log costs time of its own): the culler then renders through
+  /// the session's LoggingBackend, which stays until the renderer or the
+  /// stall guard is replaced, so the culler may read that frame's queries
+  /// later (next frame, or when it is destroyed).
   FrameStats run_frame(Culler& culler, const View& view, double time_s, FrameLog* log = nullptr);
 
   /// The ground truth of frames 0..frames-1 of `path` (untimed), each
@@ -267,6 +270,7 @@ class Session {
   std::unique_ptr<gl::Renderer> renderer_;
   double stall_guard_ms_ = 0.0;
   std::unique_ptr<StallGuard> guard_;  // over renderer_; goes before it
+  std::unique_ptr<LoggingBackend> logger_;  // over backend(), for logged frames; goes before both
   std::unique_ptr<detail::Watchdog> watchdog_;
   std::optional<HardwareProfile> profile_;
   FaultHooks hooks_;

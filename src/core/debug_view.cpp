@@ -21,8 +21,9 @@ constexpr std::array<DebugViewInfo, 7> kViews{{
     {DebugView::batches, "batches", "draws and query boxes coloured by state-change batch, in order"},
     {DebugView::overview, "overview",
      "from above: the frustum; drawn, frustum-culled, occlusion-culled and missed (red) objects"},
-    {DebugView::cells, "cells", "grid cells met: drawn (green) or hidden (red); algorithm grid"},
-    {DebugView::tiles, "tiles", "tile instances drawn (green), cells found hidden (red); tiled-world algorithms"},
+    {DebugView::cells, "cells", "from above: grid cells met, drawn (green) over hidden (red); algorithm grid"},
+    {DebugView::tiles, "tiles",
+     "from above: tile instances drawn (green) over cells found hidden (red); tiled-world algorithms"},
 }};
 
 // The query's boxes hold the centre of object `id`.
@@ -126,25 +127,8 @@ Picture batches_picture(const DebugFrame& f) {
   return p;
 }
 
-Picture regions_picture(const DebugFrame& f, std::string_view what) {
-  Picture p = over_frame(f);
-  std::size_t shown = 0, hidden = 0;
-  for (const CullRegion& r : f.regions) {
-    // One layer: nearer regions cover farther ones, as in the thesis' Figure 4.2.
-    p.boxes.push_back({r.box, r.visible ? palette::visible : palette::occluded, 0});
-    ++(r.visible ? shown : hidden);
-  }
-  p.legend.push_back({fmt::format("{} drawn", what), palette::visible, shown});
-  p.legend.push_back({fmt::format("{} hidden", what), palette::occluded, hidden});
-  return p;
-}
-
-// Looks straight down (-y) on the scene's box and the eye, fitted to `aspect`.
-Picture overview_picture(const DebugFrame& f, float aspect) {
-  Picture p;
-  p.frame_background = false;
-  Aabb area = f.scene.bounds();
-  area.extend(f.view.eye);
+// A camera looking straight down (-y) on `area`, fitted to `aspect`, north (-z) up.
+glm::mat4 top_down(const Aabb& area, float aspect) {
   const glm::vec3 centre = area.center();
   const glm::vec3 size = area.max - area.min;
   // x to the right, -z up in the image (north up), with a 5 % margin.
@@ -153,7 +137,60 @@ Picture overview_picture(const DebugFrame& f, float aspect) {
   const float top = area.max.y + 1.0f, depth = std::max(size.y, 1e-3f) + 2.0f;
   const glm::mat4 look = glm::lookAt(glm::vec3(centre.x, top, centre.z), glm::vec3(centre.x, top - 1.0f, centre.z),
                                      glm::vec3(0.0f, 0.0f, -1.0f));
-  p.view_proj = glm::ortho(-half_w, half_w, -half_h, half_h, 0.0f, depth) * look;
+  return glm::ortho(-half_w, half_w, -half_h, half_h, 0.0f, depth) * look;
+}
+
+// The frustum's edges: its four side edges, and the near and far rectangles.
+void frustum_lines(const View& view, std::vector<Picture::Line>& out) {
+  const glm::mat4 inv = glm::inverse(view.view_proj);
+  const auto corner = [&](float x, float y, float z) {
+    const glm::vec4 w = inv * glm::vec4(x, y, z, 1.0f);
+    return glm::vec3(w) / w.w;
+  };
+  std::array<glm::vec3, 4> near_c, far_c;
+  for (int i = 0; i < 4; ++i) {
+    const float x = (i == 1 || i == 2) ? 1.0f : -1.0f, y = i >= 2 ? 1.0f : -1.0f;
+    near_c[std::size_t(i)] = corner(x, y, -1.0f);
+    far_c[std::size_t(i)] = corner(x, y, 1.0f);
+  }
+  for (std::size_t i = 0; i < 4; ++i) {
+    out.push_back({near_c[i], far_c[i], palette::frustum});
+    out.push_back({far_c[i], far_c[(i + 1) % 4], palette::frustum});
+    out.push_back({near_c[i], near_c[(i + 1) % 4], palette::frustum});
+  }
+}
+
+// From above, as the thesis' Figure 4.2: each region's footprint, drawn
+// ones over hidden ones (a column with a drawn cell shows drawn), and the frustum.
+Picture regions_picture(const DebugFrame& f, std::string_view what, float aspect) {
+  Picture p;
+  p.frame_background = false;
+  Aabb area;
+  area.extend(f.view.eye);
+  for (const CullRegion& r : f.regions) area.extend(r.box);
+  p.view_proj = top_down(area, aspect);
+  std::size_t shown = 0, hidden = 0;
+  for (const CullRegion& r : f.regions) {
+    Aabb footprint = r.box;
+    footprint.max.y = footprint.min.y = area.min.y;
+    p.boxes.push_back({footprint, r.visible ? palette::visible : palette::occluded, std::uint8_t(r.visible ? 1 : 0)});
+    ++(r.visible ? shown : hidden);
+  }
+  std::stable_sort(p.boxes.begin(), p.boxes.end(),
+                   [](const Picture::Box& a, const Picture::Box& b) { return a.layer < b.layer; });
+  frustum_lines(f.view, p.lines);
+  p.legend.push_back({fmt::format("{} drawn", what), palette::visible, shown});
+  p.legend.push_back({fmt::format("{} hidden", what), palette::occluded, hidden});
+  return p;
+}
+
+// Looks straight down on the scene's box and the eye.
+Picture overview_picture(const DebugFrame& f, float aspect) {
+  Picture p;
+  p.frame_background = false;
+  Aabb area = f.scene.bounds();
+  area.extend(f.view.eye);
+  p.view_proj = top_down(area, aspect);
 
   std::vector<ObjectId> drawn(f.drawn.begin(), f.drawn.end());
   std::sort(drawn.begin(), drawn.end());
@@ -183,23 +220,7 @@ Picture overview_picture(const DebugFrame& f, float aspect) {
   // Missed objects last, so nothing is drawn over them at equal depth.
   std::stable_partition(p.objects.begin(), p.objects.end(),
                         [](const Picture::Paint& o) { return o.color != palette::missed; });
-  // The frustum: its four side edges from the near to the far plane, and the far rectangle.
-  const glm::mat4 inv = glm::inverse(f.view.view_proj);
-  const auto corner = [&](float x, float y, float z) {
-    const glm::vec4 w = inv * glm::vec4(x, y, z, 1.0f);
-    return glm::vec3(w) / w.w;
-  };
-  std::array<glm::vec3, 4> near_c, far_c;
-  for (int i = 0; i < 4; ++i) {
-    const float x = (i == 1 || i == 2) ? 1.0f : -1.0f, y = i >= 2 ? 1.0f : -1.0f;
-    near_c[std::size_t(i)] = corner(x, y, -1.0f);
-    far_c[std::size_t(i)] = corner(x, y, 1.0f);
-  }
-  for (std::size_t i = 0; i < 4; ++i) {
-    p.lines.push_back({near_c[i], far_c[i], palette::frustum});
-    p.lines.push_back({far_c[i], far_c[(i + 1) % 4], palette::frustum});
-    p.lines.push_back({near_c[i], near_c[(i + 1) % 4], palette::frustum});
-  }
+  frustum_lines(f.view, p.lines);
   p.legend.push_back({"drawn", palette::drawn, n_drawn});
   p.legend.push_back({"outside the frustum", palette::frustum_culled, n_frustum});
   p.legend.push_back({"occlusion-culled", palette::occlusion_culled, n_occlusion});
@@ -280,8 +301,8 @@ Picture make_picture(DebugView view, const DebugFrame& frame, float aspect) {
     case DebugView::multiqueries: return multiqueries_picture(frame);
     case DebugView::batches: return batches_picture(frame);
     case DebugView::overview: return overview_picture(frame, aspect);
-    case DebugView::cells: return regions_picture(frame, "cells");
-    case DebugView::tiles: return regions_picture(frame, "tiles");
+    case DebugView::cells: return regions_picture(frame, "cells", aspect);
+    case DebugView::tiles: return regions_picture(frame, "tiles", aspect);
   }
   return over_frame(frame);
 }

@@ -123,6 +123,7 @@ void Session::set_stall_guard(double timeout_ms) {
   if (!(timeout_ms >= 0.0) || !std::isfinite(timeout_ms))
     throw InputError(fmt::format("stall guard {} ms: must be a number of milliseconds >= 0 (0: off)", timeout_ms));
   stall_guard_ms_ = timeout_ms;
+  logger_.reset();  // it wraps what backend() was
   guard_ = timeout_ms > 0.0 ? std::make_unique<StallGuard>(*renderer_, timeout_ms) : nullptr;
 }
 
@@ -132,6 +133,7 @@ Backend& Session::backend() noexcept {
 }
 
 void Session::reset_renderer() {
+  logger_.reset();
   guard_.reset();
   renderer_.reset();
   context_.reset();
@@ -141,6 +143,7 @@ void Session::reset_renderer() {
 }
 
 Session::~Session() {
+  logger_.reset();
   guard_.reset();     // reads the queries it gave up on
   renderer_.reset();  // GL objects go before the context
   context_.reset();
@@ -171,9 +174,12 @@ FrameStats Session::run_frame(Culler& culler, const View& view, double time_s, F
   const auto t0 = Clock::now();
   if (!bundle_.world) bvh_.refit(bundle_.scene);
   renderer_->begin_frame(view);
-  std::optional<LoggingBackend> recorder;
-  if (log) recorder.emplace(this->backend(), *log);
-  Backend& backend = recorder ? static_cast<Backend&>(*recorder) : this->backend();
+  // A logged frame renders through the session's logger, which lives as
+  // long as the backend it wraps: a culler may read this frame's queries
+  // through it later (in its next frame, or when it is destroyed).
+  if (log && !logger_) logger_ = std::make_unique<LoggingBackend>(this->backend());
+  if (logger_) logger_->log_into(log);
+  Backend& backend = log ? static_cast<Backend&>(*logger_) : this->backend();
   const BackendStats before = backend.stats();
   const auto c0 = Clock::now();
   FrameStats s = culler.render_frame(view, backend);
