@@ -184,6 +184,7 @@ FrameStats Session::run_frame(Culler& culler, const View& view, double time_s, F
   const auto c0 = Clock::now();
   FrameStats s = culler.render_frame(view, backend);
   const auto c1 = Clock::now();
+  if (logger_) logger_->log_into(nullptr);  // `log` is this frame's only
   const BackendStats during = backend.stats() - before;
   context_->check("a culler's frame");  // before end_frame's own glGetError, which knows less
   s.gpu_ms = renderer_->end_frame();
