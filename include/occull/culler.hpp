@@ -65,6 +65,12 @@ struct CullRegion {
 
 /// Culls and renders one view per call, keeping that view's visibility
 /// state between calls (one instance per view: split screen, shadow views).
+///
+/// A culler may keep queries in flight from one frame to the next: it reads
+/// them through the backend of a later render_frame(), or, when destroyed,
+/// through the backend of its last one (`grid` does). So the backend given
+/// to the last render_frame() must outlive the culler, and every backend a
+/// culler is given must reach the same device (a decorator over it is fine).
 class Culler {
  public:
   virtual ~Culler() = default;
