@@ -531,11 +531,11 @@ std::string numbered(const std::string& out, int frame, bool range) {
 // The views that need an algorithm of one kind refuse the others.
 void check_view_fits(occull::DebugView view, const std::string& algo_spec) {
   const occull::AlgorithmInfo& info = occull::find_algorithm(occull::parse_algorithm_spec(algo_spec).name);
-  if (view == occull::DebugView::cells && info.name != "grid")
+  if (occull::view_fits(view, info)) return;
+  if (view == occull::DebugView::cells)
     throw occull::InputError(fmt::format("--view cells shows the cells of the grid culler (--algo grid), not {}",
                                          info.name));
-  if (view == occull::DebugView::tiles && info.scenes != occull::SceneKind::tiled)
-    throw occull::InputError(fmt::format(
+  throw occull::InputError(fmt::format(
         "--view tiles shows tile instances of a tiled-world algorithm (tilevfc, pertile, tiles), not {}", info.name));
 }
 

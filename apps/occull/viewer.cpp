@@ -201,30 +201,9 @@ std::vector<std::string> runnable_algorithms(bool tiled) {
   return names;
 }
 
-// The view kind fits the algorithm (cells: grid; tiles: a tiled-world culler).
-bool view_fits(DebugView v, const AlgorithmInfo& a) {
-  if (v == DebugView::cells) return a.name == "grid";
-  if (v == DebugView::tiles) return a.scenes == SceneKind::tiled;
-  return true;
-}
-
 void write_png(const std::string& file, int w, int h, const std::vector<std::uint8_t>& rgba) {
   if (!stbi_write_png(file.c_str(), w, h, 4, rgba.data(), w * 4))
     throw InputError(fmt::format("cannot write '{}'", file));
-}
-
-Options parse_assignments(const std::string& text, const std::string& algorithm) {
-  // "key=value,key=value" of the chosen algorithm.
-  Options o;
-  std::size_t begin = 0;
-  while (begin < text.size()) {
-    std::size_t end = text.find(',', begin);
-    if (end == std::string::npos) end = text.size();
-    const std::string item = text.substr(begin, end - begin);
-    if (!item.empty()) o.set(algorithm + "." + item);
-    begin = end + 1;
-  }
-  return o;
 }
 
 }  // namespace
@@ -285,7 +264,11 @@ int run_viewer(const ViewArgs& a) {
                                  a.view, spec.name));
   auto make = [&]() {
     const std::string& name = c.algorithms[std::size_t(c.algorithm)];
-    return make_culler(name, session.index(), parse_assignments(c.options.data(), name));
+    // "key=value,key=value" of the chosen algorithm, as its spec "name:key=value:key=value".
+    const std::string typed = c.options.data();
+    std::string spec_text = typed.empty() ? name : name + ":" + typed;
+    std::replace(spec_text.begin(), spec_text.end(), ',', ':');
+    return make_culler(name, session.index(), parse_algorithm_spec(spec_text).options);
   };
   std::unique_ptr<Culler> culler = make();
   c.view = int(view_kind);

@@ -41,6 +41,9 @@ struct DebugViewInfo {
 /// The named view. Throws InputError listing the valid names.
 [[nodiscard]] DebugView parse_debug_view(std::string_view name);
 [[nodiscard]] std::string_view debug_view_name(DebugView view);
+/// Whether `algorithm` has what `view` shows: `cells` needs `grid`, `tiles`
+/// a tiled-world algorithm; the other views fit every algorithm.
+[[nodiscard]] bool view_fits(DebugView view, const AlgorithmInfo& algorithm);
 
 /// Colours of the views (linear RGB in [0, 1]); the legend of every
 /// picture names the ones it uses.

@@ -247,6 +247,12 @@ std::string_view debug_view_name(DebugView view) {
   return "?";
 }
 
+bool view_fits(DebugView view, const AlgorithmInfo& algorithm) {
+  if (view == DebugView::cells) return algorithm.name == "grid";
+  if (view == DebugView::tiles) return algorithm.scenes == SceneKind::tiled;
+  return true;
+}
+
 glm::vec3 palette::sequence(std::size_t k) {
   // Hues a golden angle apart, at two alternating brightnesses.
   const float h = std::fmod(0.61803398875f * float(k) + 0.1f, 1.0f) * 6.0f;
