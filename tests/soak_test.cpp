@@ -44,6 +44,8 @@ TEST(Soak, RunsEveryAlgorithmOverItsWindowsOnTheTurnPathReportingMemoryAndGlObje
     for (const SoakWindow& w : run.windows) {
       EXPECT_GT(w.median_ms, 0.0) << run.algorithm;
       EXPECT_GT(w.resident_bytes, 0u) << run.algorithm;
+      EXPECT_GT(w.heap_bytes, 0u) << run.algorithm;
+      EXPECT_GE(w.heap_held_bytes, w.heap_bytes) << run.algorithm << ": the heap holds at least what is in use";
       EXPECT_GT(w.queries_per_frame, 0.0) << run.algorithm;
       EXPECT_GT(w.gl.queries, 0u) << run.algorithm;  // the pool served those queries
       EXPECT_LE(w.gl.queries_free, w.gl.queries) << run.algorithm;
@@ -60,6 +62,7 @@ TEST(Soak, RunsEveryAlgorithmOverItsWindowsOnTheTurnPathReportingMemoryAndGlObje
   EXPECT_EQ(doc["format"], "occull soak 1");
   EXPECT_EQ(doc["runs"].size(), 3u);
   EXPECT_EQ(doc["runs"][0]["windows"][0]["gl_buffers"], 7);
+  EXPECT_GT(doc["runs"][0]["windows"][0]["heap_held_bytes"].get<std::uint64_t>(), 0u);
 }
 
 TEST(Soak, MemoryThatGrowsPastTheToleranceIsJudgedGrown) {

@@ -32,6 +32,10 @@ struct ProcessUsage {
 struct MemoryUsage {
   std::uint64_t resident_bytes = 0;  ///< resident set (/proc/self/statm), bytes; 0 where unknown
   std::uint64_t heap_bytes = 0;      ///< bytes malloc has handed out and not had back (glibc mallinfo2); 0 where unknown
+  /// Bytes malloc holds from the OS, in use or free (mallinfo2 arena + hblkhd,
+  /// every arena); 0 where unknown. Under the engine policy this is the heap's
+  /// high-water mark.
+  std::uint64_t heap_held_bytes = 0;
 };
 
 /// Never fails (zeros where the OS or C library says nothing).

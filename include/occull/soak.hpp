@@ -41,8 +41,9 @@ struct SoakWindow {
   std::int64_t frames = 0;
   double median_ms = 0.0, p95_ms = 0.0, max_ms = 0.0;  ///< frame time (FrameStats::frame_ms)
   double queries_per_frame = 0.0;
-  std::uint64_t resident_bytes = 0;  ///< MemoryUsage of the whole process
-  std::uint64_t heap_bytes = 0;
+  std::uint64_t resident_bytes = 0;   ///< MemoryUsage of the whole process
+  std::uint64_t heap_held_bytes = 0;  ///< MemoryUsage::heap_held_bytes
+  std::uint64_t heap_bytes = 0;       ///< MemoryUsage::heap_bytes
   gl::Renderer::Resources gl;        ///< the renderer's query pool and buffers
 };
 
@@ -55,12 +56,15 @@ struct SoakRun {
 };
 
 /// Sets `run`'s verdicts from its first and last windows. Memory is judged
-/// on the resident set: under the engine allocator policy freed memory is
-/// kept, so it is the process's high-water mark and only grows for good;
-/// the heap in use is reported but not judged (it swings by tens of MiB
-/// with what the driver holds at the moment it is read). The query pool
-/// is the most queries ever in use at once, so it may creep up with a rare
-/// peak; a leak grows it by the frames.
+/// on the resident set. Under glibc's defaults (the soak's `--malloc
+/// system`) the heap hands freed memory at its top back, so a leak shows as
+/// growth and a passing peak mostly does not. Under the engine policy freed
+/// memory is kept, so the resident set is the heap's high-water mark: it
+/// also grows with a rare peak of what the driver holds and with the heap's
+/// fragmentation (heap held shows this). The heap in use is reported but
+/// not judged (it swings by tens of MiB with what the driver holds at the
+/// moment it is read). The query pool is the most queries ever in use at
+/// once, so it may creep up with a rare peak; a leak grows it by the frames.
 void judge_soak_run(SoakRun& run, double tolerance);
 
 struct SoakResult {

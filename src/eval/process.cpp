@@ -37,6 +37,7 @@ MemoryUsage memory_usage() noexcept {
 #if defined(__GLIBC__) && (__GLIBC__ > 2 || __GLIBC_MINOR__ >= 33)
   const struct mallinfo2 mi = mallinfo2();
   m.heap_bytes = std::uint64_t(mi.uordblks) + std::uint64_t(mi.hblkhd);
+  m.heap_held_bytes = std::uint64_t(mi.arena) + std::uint64_t(mi.hblkhd);
 #endif
   return m;
 }

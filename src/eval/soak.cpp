@@ -67,6 +67,7 @@ void soak_one(Session& session, SoakRun& run, const SoakConfig& c, const CameraP
     w.queries_per_frame = double(queries) / double(c.window);
     const MemoryUsage m = memory_usage();
     w.resident_bytes = m.resident_bytes;
+    w.heap_held_bytes = m.heap_held_bytes;
     w.heap_bytes = m.heap_bytes;
     w.gl = session.renderer().resources();
     run.windows.push_back(w);
@@ -126,14 +127,16 @@ std::string soak_header(const SoakResult& result) {
 }
 
 std::string soak_columns(const std::string& algorithm) {
-  return fmt::format("\n{}\n{:>9} {:>9} {:>8} {:>8} {:>9} {:>9} {:>9} {:>8} {:>8} {:>9}\n", algorithm, "frames",
-                     "median ms", "p95 ms", "max ms", "queries/f", "RSS MiB", "heap MiB", "queries", "free", "buf MiB");
+  return fmt::format("\n{}\n{:>9} {:>9} {:>8} {:>8} {:>9} {:>9} {:>9} {:>9} {:>8} {:>8} {:>9}\n", algorithm,
+                     "frames", "median ms", "p95 ms", "max ms", "queries/f", "RSS MiB", "held MiB", "heap MiB",
+                     "queries", "free", "buf MiB");
 }
 
 std::string soak_row(const SoakWindow& w) {
-  return fmt::format("{:>9} {:>9.3f} {:>8.3f} {:>8.2f} {:>9.1f} {:>9.1f} {:>9.1f} {:>8} {:>8} {:>9.2f}\n",
+  return fmt::format("{:>9} {:>9.3f} {:>8.3f} {:>8.2f} {:>9.1f} {:>9.1f} {:>9.1f} {:>9.1f} {:>8} {:>8} {:>9.2f}\n",
                      fmt::format("{}k", double(w.first_frame + w.frames) / 1000.0), w.median_ms, w.p95_ms, w.max_ms,
-                     w.queries_per_frame, mib(w.resident_bytes), mib(w.heap_bytes), w.gl.queries, w.gl.queries_free,
+                     w.queries_per_frame, mib(w.resident_bytes), mib(w.heap_held_bytes), mib(w.heap_bytes),
+                     w.gl.queries, w.gl.queries_free,
                      mib(std::uint64_t(w.gl.buffer_bytes)));
 }
 
@@ -141,11 +144,13 @@ std::string soak_run_verdict(const SoakRun& r) {
   if (r.windows.empty()) return {};
   const SoakWindow& a = r.windows.front();
   const SoakWindow& b = r.windows.back();
-  return fmt::format("{}: memory {} (RSS {:+.1f}%), query pool and buffers {} ({} -> {} queries), "
-                     "median frame time x{:.3f}, last window vs first\n",
-                     r.algorithm, r.memory_flat ? "flat" : "GREW",
-                     a.resident_bytes ? 100.0 * (double(b.resident_bytes) / double(a.resident_bytes) - 1.0) : 0.0,
-                     r.pool_flat ? "flat" : "GREW", a.gl.queries, b.gl.queries, r.time_drift);
+  const auto growth = [](std::uint64_t first, std::uint64_t last) {
+    return first ? 100.0 * (double(last) / double(first) - 1.0) : 0.0;
+  };
+  return fmt::format("{}: memory {} (RSS {:+.1f}%; heap held {:+.1f}%, not judged), query pool and buffers {} "
+                     "({} -> {} queries), median frame time x{:.3f}, last window vs first\n",
+                     r.algorithm, r.memory_flat ? "flat" : "GREW", growth(a.resident_bytes, b.resident_bytes),
+                     growth(a.heap_held_bytes, b.heap_held_bytes), r.pool_flat ? "flat" : "GREW", a.gl.queries, b.gl.queries, r.time_drift);
 }
 
 std::string soak_verdict(const SoakResult& result) {
@@ -191,7 +196,8 @@ void write_soak_json(const SoakResult& result, std::ostream& out) {
     for (const SoakWindow& w : r.windows)
       windows.push_back({{"first_frame", w.first_frame}, {"frames", w.frames}, {"median_ms", w.median_ms},
                          {"p95_ms", w.p95_ms}, {"max_ms", w.max_ms}, {"queries_per_frame", w.queries_per_frame},
-                         {"resident_bytes", w.resident_bytes}, {"heap_bytes", w.heap_bytes},
+                         {"resident_bytes", w.resident_bytes}, {"heap_held_bytes", w.heap_held_bytes},
+                         {"heap_bytes", w.heap_bytes},
                          {"gl_queries", w.gl.queries}, {"gl_queries_free", w.gl.queries_free},
                          {"gl_buffers", w.gl.buffers}, {"gl_buffer_bytes", w.gl.buffer_bytes}});
     runs.push_back({{"algorithm", r.algorithm}, {"memory_flat", r.memory_flat}, {"pool_flat", r.pool_flat},
