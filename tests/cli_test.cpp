@@ -217,8 +217,8 @@ TEST(Cli, RenderDebugViewWritesANumberedSequenceAndItsLegend) {
 }
 
 TEST(Cli, RenderShowsTheGridsCellsAndEndsCleanly) {
-  // The grid culler reads its last queries when it goes: through the
-  // session's logger, which must still be there (it was not: a crash).
+  // The grid culler holds its last frame's queries until render hands them
+  // back (a crash once, when it read them through a logger gone by then).
   const CliRun r = run(std::string("render ") + kTinyCity + " --algo grid --view cells --frame 3 --frames 5 --out /dev/null");
   EXPECT_EQ(r.code, 0) << r.output;
   EXPECT_NE(r.output.find("cells drawn"), std::string::npos) << r.output;

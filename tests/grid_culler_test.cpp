@@ -59,7 +59,7 @@ std::size_t times_drawn(const test::RecordingBackend& b, ObjectId id) {
 
 TEST(Grid, HidesAnOccludedCellFromTheFrameAfterItsQueryAndQueriesItAgainEachFrame) {
   Stage s;
-  test::RecordingBackend backend;  // outlives the culler, which reads its last queries on destruction
+  test::RecordingBackend backend;
   auto culler = s.make();
   backend.visible_samples = behind_wall;
   for (int frame = 1; frame <= 4; ++frame) {
@@ -149,7 +149,7 @@ TEST(Grid, CapsQueriesExceptForCellsThatWereVisible) {
 
 TEST(Grid, DrawsAnObjectOncePerFrameOccludersFirst) {
   Stage s;
-  test::RecordingBackend backend;  // outlives the culler, which reads its last queries on destruction
+  test::RecordingBackend backend;
   auto culler = s.make();
   for (int frame = 1; frame <= 3; ++frame) {
     backend.rendered.clear();
@@ -353,7 +353,7 @@ TEST(GridViews, ViewsShareOneGridAndTheViewWhoseHiddenCellsComeIntoSightGetsTheL
   // other frame everything is visible), so re-queries of its hidden cells
   // find them visible again; in view 1 the wall stands.
   int frame = 0;
-  test::RecordingBackend flicker, steady;  // outlive the views, which read their last queries on destruction
+  test::RecordingBackend flicker, steady;
   flicker.visible_samples = [&frame](std::span<const Aabb> boxes) {
     return frame % 2 == 0 ? std::uint64_t(boxes.size()) : behind_wall(boxes);
   };

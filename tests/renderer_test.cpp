@@ -81,6 +81,26 @@ TEST_F(RendererTest, BoxBehindOccluderHasNoSamplesAndVisibleBoxHasSome) {
   EXPECT_EQ(r.queries_in_flight(), 0u);
 }
 
+TEST_F(RendererTest, AQueryNotInFlightIsRefusedLoudly) {
+  // Read twice, a query would go back to the pool twice and later be handed
+  // to two users at once.
+  WallScene w;
+  gl::Renderer r(w.scene, small());
+  begin_with_wall(r, w);
+  const Aabb beside[] = {w.scene.object(WallScene::beside).bounds};
+  const QueryId q = r.issue_query(beside);
+  EXPECT_GT(r.result(q), 0u);
+  EXPECT_THROW((void)r.result(q), std::logic_error);
+  EXPECT_THROW((void)r.result_available(q), std::logic_error);
+  EXPECT_THROW((void)r.result(q + 100), std::logic_error);  // never issued
+  const QueryId a = r.issue_query(beside), b = r.issue_query(beside);
+  EXPECT_NE(a, b);  // the pool still hands out distinct queries
+  (void)r.result(a);
+  (void)r.result(b);
+  r.end_frame();
+  EXPECT_EQ(r.queries_in_flight(), 0u);
+}
+
 TEST_F(RendererTest, MultiBoxQueryCountsTheUnion) {
   WallScene w;
   gl::Renderer r(w.scene, small());

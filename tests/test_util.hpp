@@ -8,6 +8,8 @@
 #include <glm/gtc/matrix_transform.hpp>
 
 #include <functional>
+#include <stdexcept>
+#include <string>
 #include <vector>
 
 namespace occull::test {
@@ -67,8 +69,17 @@ inline Scene glass_scene() {
 /// Backend double: records what was rendered and queried; a query's
 /// result comes from `visible_samples(boxes)` (default: 1 sample per box)
 /// and is available when `available(query)` says so (default: at once).
+///
+/// It enforces the query contract of occull/backend.hpp and throws
+/// std::logic_error, failing the test loudly, for a query read twice, read
+/// or polled after it was read, or that this backend never issued (one of
+/// another device: give two backends different `first_id`s to tell them
+/// apart). in_flight() counts the queries issued and never read.
 class RecordingBackend final : public Backend {
  public:
+  /// Query ids start at `first_id`: query q is queried[q - first_id].
+  explicit RecordingBackend(QueryId first_id = 0) : first_id_(first_id) {}
+
   std::function<std::uint64_t(std::span<const Aabb>)> visible_samples =
       [](std::span<const Aabb> b) { return std::uint64_t(b.size()); };
   std::function<bool(QueryId)> available = [](QueryId) { return true; };
@@ -86,26 +97,50 @@ class RecordingBackend final : public Backend {
   }
   [[nodiscard]] bool conditional_rendering() const override { return conditional; }
   void render_conditional(std::span<const ObjectId> objects, QueryId q, ConditionalWait wait) override {
+    check_in_flight(q, "render_conditional");
     if (!conditional) return Backend::render_conditional(objects, q, wait);
     for (ObjectId id : objects) rendered_conditionally.emplace_back(id, q);
     render(objects);
   }
   QueryId issue_query(std::span<const Aabb> boxes) override {
+    if (boxes.empty()) throw std::logic_error("RecordingBackend::issue_query: no boxes");
     queried.emplace_back(boxes.begin(), boxes.end());
     results_.push_back(visible_samples(boxes));
+    live_.push_back(1);
+    ++in_flight_;
     ++stats_.queries;
-    return QueryId(results_.size() - 1);
+    return first_id_ + QueryId(results_.size() - 1);
   }
-  bool result_available(QueryId q) override { return available(q); }
+  bool result_available(QueryId q) override {
+    check_in_flight(q, "result_available");
+    return available(q);
+  }
   std::uint64_t result(QueryId q) override {
+    check_in_flight(q, "result");
+    live_[q - first_id_] = 0;
+    --in_flight_;
     read.push_back(q);
-    return results_.at(q);
+    return results_[q - first_id_];
   }
   [[nodiscard]] BackendStats stats() const override { return stats_; }
   std::vector<QueryId> read;  ///< queries whose result() was called, in order
+  /// Queries issued and not yet read.
+  [[nodiscard]] std::size_t in_flight() const noexcept { return in_flight_; }
 
  private:
+  void check_in_flight(QueryId q, const char* call) const {
+    if (q < first_id_ || q - first_id_ >= live_.size())
+      throw std::logic_error("RecordingBackend::" + std::string(call) + ": query " + std::to_string(q) +
+                             " was never issued by this backend");
+    if (!live_[q - first_id_])
+      throw std::logic_error("RecordingBackend::" + std::string(call) + ": query " + std::to_string(q) +
+                             " was read already");
+  }
+
+  QueryId first_id_;
   std::vector<std::uint64_t> results_;
+  std::vector<std::uint8_t> live_;
+  std::size_t in_flight_ = 0;
   BackendStats stats_;
 };
 

@@ -597,6 +597,7 @@ int cmd_render(const RenderArgs& a) {
                file, size.width, size.height, a.scene, path.name(), k, algo, a.view, stats.objects_rendered,
                stats.triangles, stats.queries, legend);
   }
+  session.release(*culler);
   return 0;
 }
 

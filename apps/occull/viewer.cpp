@@ -271,6 +271,7 @@ int run_viewer(const ViewArgs& a) {
     return make_culler(name, session.index(), parse_algorithm_spec(spec_text).options);
   };
   std::unique_ptr<Culler> culler = make();
+  std::unique_ptr<Culler> next_culler;  // chosen in the panel; replaces `culler` in occull's context
   c.view = int(view_kind);
   c.verify = a.verify;
   const std::string record_default = a.record.empty() ? "occull-flight.path" : a.record;
@@ -321,6 +322,10 @@ int run_viewer(const ViewArgs& a) {
     // occull's context: the frame, its view, its truth.
     Window::release();
     session.context().make_current();
+    if (next_culler) {
+      session.release(*culler);  // its queries live on occull's context
+      culler = std::move(next_culler);
+    }
     const View view = make_view(camera.pose, session.bundle().lens, width, height);
     FrameLog log;
     const FrameStats stats = session.run_frame(*culler, view, time_s, &log);
@@ -366,9 +371,8 @@ int run_viewer(const ViewArgs& a) {
       bool rebuild = ImGui::Combo("algorithm", &c.algorithm, names, &c.algorithms, int(c.algorithms.size()));
       rebuild |= ImGui::InputText("options", c.options.data(), c.options.size(), ImGuiInputTextFlags_EnterReturnsTrue);
       if (rebuild) {
-        // Each culler in occull's context (a culler may create GL-free state only, but keep one rule).
         try {
-          culler = make();
+          next_culler = make();  // GL-free; the old one hands its queries back in occull's context
           c.message.clear();
         } catch (const InputError& e) {
           c.message = e.what();
@@ -435,6 +439,7 @@ int run_viewer(const ViewArgs& a) {
   }
   window_owner.reset();
   session.context().make_current();  // the painter and the session go in their own context
+  session.release(*culler);
   return 0;
 }
 

@@ -59,10 +59,24 @@ class Bvh {
   /// of a tile whose objects occupy consecutive ids from `first_object`.
   [[nodiscard]] Bvh instance(const glm::vec3& offset, ObjectId first_object) const;
 
-  /// Recomputes node bounds from the objects' current bounds (after
-  /// Scene::update). Only the dynamic subtree and its ancestors are touched
-  /// when dynamic objects are separated. Precondition: same scene as build.
+  /// Follows the scene after the frame's changes (Scene::update, and an
+  /// engine's set_transform, add_object, remove_object), before the cullers
+  /// run. Refits the dynamic subtree and the ancestors of every object the
+  /// engine changed (Scene::for_each_changed_since), so no node's box is
+  /// stale. Rebuilds the whole hierarchy (generation() changes) when objects
+  /// were added past the count it was built over, or when refitting let its
+  /// SAH cost grow past kRebuildFactor times its cost right after the last
+  /// build. Precondition: same scene as build.
   void refit(const Scene& scene);
+
+  /// SAH cost growth (sah_cost() over its value after the last build) past
+  /// which refit() rebuilds.
+  static constexpr double kRebuildFactor = 1.25;
+  /// Changes whenever the nodes were rebuilt: node ids and the objects under
+  /// them mean something else. Cullers that keep state per node compare it.
+  [[nodiscard]] std::uint64_t generation() const noexcept { return generation_; }
+  /// SAH cost (sah_cost(traversal cost of the build)) right after the last build.
+  [[nodiscard]] double built_sah_cost() const noexcept { return built_sah_; }
 
   [[nodiscard]] std::span<const BvhNode> nodes() const noexcept { return nodes_; }
   [[nodiscard]] const BvhNode& node(NodeId n) const { return nodes_[n]; }
@@ -107,6 +121,15 @@ class Bvh {
   std::vector<BvhNode> nodes_;
   std::vector<ObjectId> objects_;
   NodeId dynamic_root_ = kNoNode;  // first node of the dynamic subtree, if separated
+  BvhOptions options_;             // of the last build, for rebuilds
+  std::vector<NodeId> leaf_of_;    // per object: the leaf holding it
+  std::size_t built_objects_ = 0;  // Scene::objects().size() at the last build
+  std::uint64_t seen_placement_ = 0;  // Scene::placement_revision() refit() has followed
+  std::uint64_t generation_ = 0;
+  double built_sah_ = 0.0;
+  std::vector<NodeId> dirty_;      // refit()'s scratch: nodes to refit
+  std::vector<std::uint8_t> marked_;
+  void finish_build();             // leaf_of_, built_sah_ of a new tree
 };
 
 }  // namespace occull

@@ -10,6 +10,7 @@
 #pragma once
 
 #include "occull/geometry.hpp"
+#include "occull/view.hpp"
 
 #include <cstdint>
 #include <map>
@@ -53,6 +54,12 @@ struct NodeCost {
 /// A_bb: box surface area, θ: vertical field of view (radians).
 [[nodiscard]] double bbox_screen_fraction(double box_area, double distance, int width, int height,
                                           double fov_y);
+/// The same fraction for the projection of `view` (asymmetric, jittered,
+/// orthographic): the screen spans 2d / proj[0][0] by 2d / proj[1][1] scene
+/// units at distance d (2 / proj[0][0] by 2 / proj[1][1] at any distance
+/// when orthographic). Equals the formula above for a symmetric perspective
+/// view with θ = 2 atan(1 / proj[1][1]).
+[[nodiscard]] double bbox_screen_fraction(double box_area, double distance, const View& view);
 
 /// R_cov = 3/2 · A(O) / A_bb (sphere-like objects seen face-on boxes).
 [[nodiscard]] double coverage_ratio(double object_area, double box_area);

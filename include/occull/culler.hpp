@@ -66,11 +66,15 @@ struct CullRegion {
 /// Culls and renders one view per call, keeping that view's visibility
 /// state between calls (one instance per view: split screen, shadow views).
 ///
-/// A culler may keep queries in flight from one frame to the next: it reads
-/// them through the backend of a later render_frame(), or, when destroyed,
-/// through the backend of its last one (`grid` does). So the backend given
-/// to the last render_frame() must outlive the culler, and every backend a
-/// culler is given must reach the same device (a decorator over it is fine).
+/// Query ownership. A culler may keep queries in flight from one frame to
+/// the next (`grid`, `perobject`, `tiles` do: their answers arrive late); it
+/// keeps no Backend between calls. Whoever owns the culler hands its queries
+/// back with release() before the backend, or its device, goes away, and
+/// before destroying a culler that holds any (queries_held() > 0): a culler
+/// destroyed holding queries cannot read them, and they stay allocated in
+/// the backend. Every backend given to one culler must reach the same device
+/// (a decorator over it is fine), since a query is read through the backend
+/// of a later call.
 class Culler {
  public:
   virtual ~Culler() = default;
@@ -94,6 +98,18 @@ class Culler {
   /// queried). Empty for cullers without such regions. Valid until the
   /// next render_frame().
   [[nodiscard]] virtual std::span<const CullRegion> regions() const { return {}; }
+
+  /// Hands back every query the culler holds, through `backend` (which must
+  /// reach the device they were issued on): the answers it can use are read
+  /// and kept as its next frame would keep them, so nothing it learned is
+  /// lost; afterwards queries_held() is 0. The culler stays usable: a later
+  /// render_frame() goes on from there. Call it at the end of a run, before
+  /// the backend goes, and before destroying the culler.
+  virtual void release(Backend& backend) { (void)backend; }
+
+  /// Queries issued by this culler and not yet read (0 for cullers that read
+  /// every query within the frame that issued it).
+  [[nodiscard]] virtual std::size_t queries_held() const { return 0; }
 };
 
 struct OptionInfo {

@@ -94,6 +94,30 @@ struct Plane {
 /// Where a box lies relative to a frustum.
 enum class Containment : std::uint8_t { outside, intersecting, inside };
 
+/// The depth range of clip space after the perspective divide: OpenGL's
+/// default [-1, 1], or [0, 1] (Vulkan, Direct3D, GL with
+/// glClipControl(..., GL_ZERO_TO_ONE)).
+enum class DepthRange : std::uint8_t { negative_one_to_one, zero_to_one };
+
+/// The clip-space conventions of a projection matrix. With `reversed_z` the
+/// near plane maps to the far end of the depth range (1) and the far plane to
+/// its near end (-1 or 0): reversed-Z, usually with DepthRange::zero_to_one,
+/// a floating-point depth buffer and a "greater" depth test.
+struct ClipSpace {
+  DepthRange depth = DepthRange::negative_one_to_one;
+  bool reversed_z = false;
+
+  /// Normalised depth of the near plane (-1, 0 or 1).
+  [[nodiscard]] float near_depth() const noexcept {
+    return reversed_z ? 1.0f : (depth == DepthRange::zero_to_one ? 0.0f : -1.0f);
+  }
+  /// Normalised depth of the far plane.
+  [[nodiscard]] float far_depth() const noexcept {
+    return reversed_z ? (depth == DepthRange::zero_to_one ? 0.0f : -1.0f) : 1.0f;
+  }
+  friend bool operator==(const ClipSpace&, const ClipSpace&) = default;
+};
+
 /// The six planes of a view frustum, normals pointing inwards.
 class Frustum {
  public:
@@ -102,10 +126,11 @@ class Frustum {
   static constexpr std::uint32_t all_planes = (1u << count) - 1;
 
   Frustum() = default;
-  /// Extracts the planes from a combined projection * view matrix (OpenGL
-  /// clip conventions, Gribb/Hartmann). Works for perspective and orthographic
-  /// projections.
-  [[nodiscard]] static Frustum from_view_projection(const glm::mat4& view_proj) noexcept;
+  /// Extracts the planes from a combined projection * view matrix with the
+  /// clip conventions `clip` (Gribb/Hartmann; OpenGL's by default). Works
+  /// for perspective and orthographic, symmetric and asymmetric projections.
+  /// A plane at infinity (an infinite far plane) keeps every box inside.
+  [[nodiscard]] static Frustum from_view_projection(const glm::mat4& view_proj, const ClipSpace& clip = {}) noexcept;
 
   [[nodiscard]] const Plane& plane(int side) const noexcept { return planes_[side]; }
 

@@ -153,10 +153,17 @@ class Session {
   /// glFinish). Fills every timing and backend counter of the result.
   /// With `log`, also logs the culler's backend calls into it (the debug
   /// views; the log costs time of its own): the culler then renders through
-  /// the session's LoggingBackend, which stays until the renderer or the
-  /// stall guard is replaced, so the culler may read that frame's queries
-  /// later (next frame, or when it is destroyed).
+  /// the session's LoggingBackend, a decorator over the same device.
   FrameStats run_frame(Culler& culler, const View& view, double time_s, FrameLog* log = nullptr);
+
+  /// Hands back every query `culler` holds (Culler::release) through the
+  /// session's backend. Call it when a culler's run ends, before the culler
+  /// goes and before reset_renderer().
+  void release(Culler& culler);
+  /// The run-time invariant "queries-returned": the renderer has no query in
+  /// flight but those the stall guard gave up on. Call it once every culler
+  /// of a run was released; throws InvariantViolation naming `who` otherwise.
+  void check_queries_returned(std::string_view who) const;
 
   /// The ground truth of frames 0..frames-1 of `path` (untimed), each
   /// frame checked by the truth invariants. Throws InvariantViolation.

@@ -33,6 +33,14 @@ struct Mesh {
   [[nodiscard]] double surface_area() const noexcept;
 };
 
+/// What the culling side needs of a mesh that an engine keeps and draws
+/// itself: no vertices. occull's own renderer draws nothing for it.
+struct MeshInfo {
+  Aabb bounds;                  ///< object space; empty for a mesh without triangles
+  std::uint32_t triangles = 0;  ///< what a draw of it costs
+  double surface_area = 0.0;    ///< sum of its triangles' areas, squared object-space units (>= 0)
+};
+
 /// How an object is shaded. `shading_cost` is the number of light
 /// evaluations per fragment (0 = flat colour): the knob that makes a scene
 /// fragment-bound, as the NOHC paper's Vienna model is.
@@ -67,6 +75,7 @@ struct Object {
   std::uint32_t triangles = 0;   ///< triangle count of the mesh
   OccluderClass occluder = OccluderClass::sometimes;
   std::int32_t motion = -1;      ///< index into Scene::motions(), -1 for static objects
+  bool removed = false;          ///< removed by Scene::remove_object: empty bounds, no triangles
 
   [[nodiscard]] bool dynamic() const noexcept { return motion >= 0; }
 };
@@ -80,7 +89,14 @@ struct SceneLimits {
 
 /// A scene: the meshes, materials, objects and motions of one world.
 /// Invariant: every object's `bounds` and `triangles` match its mesh and
-/// transform (add_object and update maintain it).
+/// transform (every call that changes an object maintains it).
+///
+/// An engine drives it between frames: set_transform() moves any object,
+/// add_object() and remove_object() change the set. Object ids are stable
+/// while the object lives; a removed id keeps its slot (empty bounds, no
+/// triangles, so every culler passes it over) until a later add_object()
+/// reuses it, the most recently removed first. The hierarchy (Bvh::refit)
+/// and the cullers follow these changes by the revisions below.
 class Scene {
  public:
   explicit Scene(std::string name = {}, const SceneLimits& caps = {}) : name_(std::move(name)), caps_(caps) {}
@@ -88,11 +104,51 @@ class Scene {
   /// Adds a mesh. Precondition: indices in range, normals.size() == positions.size().
   /// Throws InputError past SceneLimits::mesh_triangles triangles in all meshes.
   MeshId add_mesh(Mesh mesh);
+  /// Adds a mesh the engine keeps itself: bounds, triangle count and area,
+  /// no vertices. Throws InputError for bounds or an area that is not finite.
+  MeshId add_mesh(const MeshInfo& info);
   MaterialId add_material(Material material);
-  /// Adds a static object. Preconditions: mesh and material exist.
-  /// Throws InputError past SceneLimits::objects objects.
+  /// Adds a static object, in the slot of the most recently removed object
+  /// if there is one. Throws InputError for a mesh or material that does not
+  /// exist, a transform that is not finite, or past SceneLimits::objects
+  /// objects; the scene is unchanged then.
   ObjectId add_object(MeshId mesh, MaterialId material, const glm::mat4& transform,
                       OccluderClass occluder);
+  /// Sets object `id`'s object-to-world transform; its bounds follow. Any
+  /// object, static or dynamic (a dynamic one's next update() puts it back
+  /// on its Motion). Throws InputError, the scene unchanged, for an id that
+  /// does not exist or was removed, or a transform with an entry that is not
+  /// finite.
+  void set_transform(ObjectId id, const glm::mat4& transform);
+  /// Removes object `id` (static or dynamic): it keeps the id with empty
+  /// bounds and no triangles until add_object() reuses it. Throws InputError,
+  /// the scene unchanged, for an id that does not exist or was removed.
+  void remove_object(ObjectId id);
+  /// Whether `id` is an object that was not removed.
+  [[nodiscard]] bool alive(ObjectId id) const noexcept { return id < objects_.size() && !objects_[id].removed; }
+
+  /// Counts every add_object() and remove_object() (not place_object):
+  /// per-object state sized or listed by the set of objects is stale when it
+  /// changed.
+  [[nodiscard]] std::uint64_t layout_revision() const noexcept { return layout_revision_; }
+  /// Counts every change of an object's transform or placement other than
+  /// update()'s: set_transform, place_object, add_object, remove_object.
+  [[nodiscard]] std::uint64_t placement_revision() const noexcept { return placement_revision_; }
+  /// Calls `f(id)` for every object changed (placed, moved, added, removed)
+  /// since placement revision `since`: from the list of moved objects when
+  /// it reaches back that far, else for every object (a consumer that missed
+  /// changes gets them all). An id may come more than once. Returns the
+  /// current placement revision, to pass next time.
+  template <class F>
+  std::uint64_t for_each_changed_since(std::uint64_t since, F&& f) const {
+    if (since == placement_revision_) return since;
+    if (since >= moved_from_revision_) {
+      for (ObjectId id : moved_) f(id);
+    } else {
+      for (ObjectId id = 0; id < objects_.size(); ++id) f(id);
+    }
+    return placement_revision_;
+  }
   /// Adds a dynamic object that follows `motion` (its transform at time 0 is
   /// applied at once). `local` is applied before the motion's transform.
   ObjectId add_dynamic_object(MeshId mesh, MaterialId material, Motion motion,
@@ -105,11 +161,16 @@ class Scene {
   /// static; mesh and material exist.
   void place_object(ObjectId id, MeshId mesh, MaterialId material, const glm::mat4& transform,
                     OccluderClass occluder);
-  /// Objects placed since the last clear_moved(), in placing order (an id
-  /// may appear more than once). A renderer that keeps transforms on the
-  /// device re-uploads these.
+  /// Objects placed, moved, added or removed since the last clear_moved(),
+  /// in order (an id may appear more than once). A renderer that keeps
+  /// transforms on the device re-uploads these. The scene clears the list
+  /// itself when it grows past the number of objects (for_each_changed_since
+  /// then visits every object), so an owner that never clears it leaks nothing.
   [[nodiscard]] std::span<const ObjectId> moved_objects() const noexcept { return moved_; }
-  void clear_moved() noexcept { moved_.clear(); }
+  void clear_moved() noexcept {
+    moved_.clear();
+    moved_from_revision_ = placement_revision_;
+  }
   /// Moves every dynamic object to where it is at `time_s` and updates its
   /// bounds. Deterministic: the same time gives the same transforms.
   void update(double time_s);
@@ -142,11 +203,19 @@ class Scene {
   std::vector<glm::mat4> dynamic_local_;  // per motion: local transform
   std::vector<ObjectId> dynamic_;
   std::vector<ObjectId> moved_;
+  std::vector<ObjectId> free_ids_;  // removed objects' ids, the most recent last
+  std::uint64_t layout_revision_ = 0;
+  std::uint64_t placement_revision_ = 0;
+  std::uint64_t moved_from_revision_ = 0;  // moved_ lists every change after this revision
+  // Records a change of object `id`'s placement.
+  void note_moved(ObjectId id);
+  void check_object(ObjectId id, const char* what) const;
   // A static object of `mesh` at `transform`, its bounds and triangles filled.
   [[nodiscard]] Object make_object(MeshId mesh, MaterialId material, const glm::mat4& transform,
                                    OccluderClass occluder) const;
   std::vector<Aabb> mesh_bounds_;
   std::vector<double> mesh_area_;
+  std::vector<std::uint32_t> mesh_triangle_count_;
   std::uint64_t mesh_triangles_ = 0;  // sum over meshes_, against caps_
 };
 

@@ -8,18 +8,30 @@
 
 namespace occull {
 
-/// One camera's view for one frame. Build it with make_view() so the derived
-/// members (view_proj, frustum) agree with the others.
+/// One camera's view for one frame. Build it with make_view() (from an
+/// engine's matrices, or from a pose and a lens) so the derived members
+/// (eye, view_proj, frustum, near, far, near_radius) agree with the others.
 struct View {
-  glm::vec3 eye{0.0f};       ///< camera position, world space
+  glm::vec3 eye{0.0f};       ///< camera position, world space (the view matrix's origin)
   glm::mat4 view{1.0f};      ///< world to eye space
-  glm::mat4 proj{1.0f};      ///< eye to clip space (OpenGL conventions)
+  glm::mat4 proj{1.0f};      ///< eye to clip space, with the conventions `clip`
   glm::mat4 view_proj{1.0f}; ///< proj * view
-  Frustum frustum;           ///< planes of view_proj
+  ClipSpace clip;            ///< depth range and reversed-Z of `proj`
+  Frustum frustum;           ///< planes of view_proj (none at an infinite far plane)
   int width = 1;             ///< viewport width, pixels (> 0)
   int height = 1;            ///< viewport height, pixels (> 0)
-  float near = 0.1f;         ///< near-plane distance, scene units (> 0)
-  float far = 1000.0f;       ///< far-plane distance, scene units (> near)
+  bool orthographic = false; ///< proj is affine (w = 1): sizes do not shrink with distance
+  /// Distance of the near plane from the eye along the view direction, scene
+  /// units: > 0 for a perspective view; any value below `far` for an
+  /// orthographic one (its near plane may lie behind the camera).
+  float near = 0.1f;
+  /// Distance of the far plane, scene units (> near); +infinity for an
+  /// infinite perspective projection.
+  float far = 1000.0f;
+  /// Distance from the eye to the farthest corner of the near-plane
+  /// rectangle, scene units: a box farther than this from the eye cannot be
+  /// cut by the near plane.
+  float near_radius = 0.0f;
 };
 
 /// Lens of a perspective camera.
@@ -37,11 +49,29 @@ struct CameraPose {
   float pitch = 0.0f;
 };
 
-/// Distance from the eye to the corners of the near-plane rectangle: a box
-/// farther than this from the eye cannot be cut by the near plane. Scene units.
-[[nodiscard]] float near_plane_radius(const View& view);
+/// View::near_radius: a box farther than this from the eye cannot be cut
+/// by the near plane. Scene units.
+[[nodiscard]] inline float near_plane_radius(const View& view) noexcept { return view.near_radius; }
 
-/// The view of `pose` through `lens` on a width x height viewport.
+/// The view of an engine's camera: `view` maps world to eye space, `proj`
+/// eye to clip space with the conventions `clip` (OpenGL's [-1, 1] depth by
+/// default; [0, 1] for Vulkan, Direct3D and glClipControl; reversed-Z),
+/// rendered on a width x height viewport. Perspective projections may be
+/// asymmetric (VR eyes, TAA jitter) and have an infinite far plane;
+/// orthographic ones (w = 1) are accepted too. Everything derived from the
+/// lens (frustum, near and far distances, the near-plane radius) comes from
+/// the matrices.
+/// Throws InputError, naming the value, for a matrix entry that is not
+/// finite, a view matrix that cannot be inverted, a singular projection, one
+/// that is neither perspective (w from eye-space z alone) nor orthographic
+/// (w constant), a perspective near plane not in front of the eye, depth
+/// that does not run from near to far, or a side outside [1,
+/// limits::viewport_side].
+[[nodiscard]] View make_view(const glm::mat4& view, const glm::mat4& proj, int width, int height,
+                             const ClipSpace& clip = {});
+
+/// The view of `pose` through `lens` on a width x height viewport, with
+/// OpenGL's clip conventions (a symmetric perspective projection).
 /// Throws InputError, naming the value, for a pose that is not finite, a
 /// |pitch| not below pi/2, a field of view outside (0, 180) degrees, a lens
 /// without 0 < near < far < infinity (a near plane of 0 leaves the depth

@@ -1,6 +1,7 @@
 #include "occull/bvh.hpp"
 
 #include <algorithm>
+#include <functional>
 #include <cassert>
 #include <limits>
 
@@ -171,7 +172,21 @@ Bvh Bvh::build(const Scene& scene, const BvhOptions& options) {
   }
   bvh.objects_.reserve(items.size());
   for (const auto& it : items) bvh.objects_.push_back(it.id);
+  bvh.options_ = options;
+  bvh.built_objects_ = objects.size();
+  bvh.seen_placement_ = scene.placement_revision();
+  bvh.finish_build();
   return bvh;
+}
+
+void Bvh::finish_build() {
+  leaf_of_.assign(objects_.size(), kNoNode);
+  for (NodeId n = 0; n < nodes_.size(); ++n)
+    if (nodes_[n].is_leaf())
+      for (ObjectId id : objects(n))
+        if (id < leaf_of_.size()) leaf_of_[id] = n;
+  built_sah_ = sah_cost(options_.traversal_cost);
+  marked_.assign(nodes_.size(), 0);
 }
 
 Bvh Bvh::build(std::span<const Aabb> bounds, std::span<const std::uint32_t> triangles,
@@ -187,6 +202,9 @@ Bvh Bvh::build(std::span<const Aabb> bounds, std::span<const std::uint32_t> tria
   builder.build(0, items.size(), kNoNode, 0);
   bvh.objects_.reserve(items.size());
   for (const auto& it : items) bvh.objects_.push_back(it.id);
+  bvh.options_ = options;
+  bvh.built_objects_ = bounds.size();
+  bvh.finish_build();
   return bvh;
 }
 
@@ -202,22 +220,63 @@ Bvh Bvh::instance(const glm::vec3& offset, ObjectId first_object) const {
 }
 
 void Bvh::refit(const Scene& scene) {
+  if (scene.objects().size() != built_objects_) {  // objects added: new leaves
+    const std::uint64_t generation = generation_;
+    *this = build(scene, options_);
+    generation_ = generation + 1;
+    return;
+  }
   const auto objects = scene.objects();
   const auto refit_node = [&](NodeId n) {
     BvhNode& node = nodes_[n];
     if (node.is_leaf()) {
       node.bounds = Aabb{};
-      for (ObjectId id : this->objects(n)) node.bounds.extend(objects[id].bounds);
+      node.triangles = 0;
+      for (ObjectId id : this->objects(n)) {
+        node.bounds.extend(objects[id].bounds);
+        node.triangles += objects[id].triangles;
+      }
     } else {
       node.bounds = nodes_[left(n)].bounds;
       node.bounds.extend(nodes_[node.right].bounds);
+      node.triangles = nodes_[left(n)].triangles + nodes_[node.right].triangles;
     }
   };
+  // The dynamic subtree: its objects move every frame (Scene::update).
   // Children follow their parents in the array, so a reverse sweep sees
   // every child before its parent.
-  const NodeId first = dynamic_root_ != kNoNode ? dynamic_root_ : 0;
-  for (NodeId n = NodeId(nodes_.size()); n-- > first;) refit_node(n);
-  if (first != 0) refit_node(root());
+  bool root_stale = false;
+  if (dynamic_root_ != kNoNode) {
+    for (NodeId n = NodeId(nodes_.size()); n-- > dynamic_root_;) refit_node(n);
+    root_stale = true;
+  } else if (!scene.dynamic_objects().empty()) {  // one tree for all
+    for (NodeId n = NodeId(nodes_.size()); n-- > 0;) refit_node(n);
+  }
+  // What the engine changed: each object's leaf and its ancestors.
+  dirty_.clear();
+  seen_placement_ = scene.for_each_changed_since(seen_placement_, [&](ObjectId id) {
+    for (NodeId n = leaf_of_[id]; n != kNoNode && !marked_[n]; n = nodes_[n].parent) {
+      marked_[n] = 1;
+      dirty_.push_back(n);
+    }
+  });
+  if (dirty_.empty()) {
+    if (root_stale) refit_node(root());
+    return;
+  }
+  std::sort(dirty_.begin(), dirty_.end(), std::greater<>());  // children before parents
+  for (NodeId n : dirty_) {
+    marked_[n] = 0;
+    if (n >= (dynamic_root_ != kNoNode ? dynamic_root_ : NodeId(nodes_.size()))) continue;  // refit above
+    refit_node(n);
+  }
+  if (root_stale) refit_node(root());
+  // Boxes that moved far loosen the tree: rebuild when it got too costly.
+  if (sah_cost(options_.traversal_cost) > kRebuildFactor * built_sah_) {
+    const std::uint64_t generation = generation_;
+    *this = build(scene, options_);
+    generation_ = generation + 1;
+  }
 }
 
 void Bvh::gather_tight_boxes(NodeId n, int d_max, float s_max, const Scene& scene,

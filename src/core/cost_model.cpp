@@ -32,6 +32,13 @@ double bbox_screen_fraction(double box_area, double distance, int width, int hei
   return std::clamp(k * k * box_area / 6.0, 0.0, 1.0);
 }
 
+double bbox_screen_fraction(double box_area, double distance, const View& view) {
+  const double scale = std::abs(double(view.proj[0][0]) * double(view.proj[1][1])) / 4.0;
+  if (view.orthographic) return std::clamp(scale * box_area / 6.0, 0.0, 1.0);
+  if (distance <= 0.0) return 1.0;
+  return std::clamp(scale * box_area / (6.0 * distance * distance), 0.0, 1.0);
+}
+
 double coverage_ratio(double object_area, double box_area) {
   return box_area > 0.0 ? 1.5 * object_area / box_area : 1.0;
 }

@@ -48,15 +48,27 @@ Plane Plane::from_coefficients(const glm::vec4& abcd) noexcept {
   return Plane{n / len, abcd.w / len};
 }
 
-Frustum Frustum::from_view_projection(const glm::mat4& m) noexcept {
+Frustum Frustum::from_view_projection(const glm::mat4& m, const ClipSpace& clip) noexcept {
   const auto row = [&m](int i) { return glm::vec4(m[0][i], m[1][i], m[2][i], m[3][i]); };
+  // A plane whose normal vanishes next to its offset lies at infinity (the
+  // far plane of an infinite projection): nothing is outside it.
+  const auto plane = [](const glm::vec4& abcd) {
+    const float len = glm::length(glm::vec3(abcd));
+    if (!(len > 1e-6f * std::abs(abcd.w))) return Plane{glm::vec3(0.0f), 1.0f};
+    return Plane::from_coefficients(abcd);
+  };
+  // Clip space keeps -w <= x, y <= w and lo <= z <= w, where lo is -w for
+  // depth in [-1, 1] and 0 for depth in [0, 1]. Reversed-Z swaps which of
+  // the two depth bounds is the near plane.
+  const glm::vec4 z_low = clip.depth == DepthRange::zero_to_one ? row(2) : row(3) + row(2);
+  const glm::vec4 z_high = row(3) - row(2);
   Frustum f;
-  f.planes_[left] = Plane::from_coefficients(row(3) + row(0));
-  f.planes_[right] = Plane::from_coefficients(row(3) - row(0));
-  f.planes_[bottom] = Plane::from_coefficients(row(3) + row(1));
-  f.planes_[top] = Plane::from_coefficients(row(3) - row(1));
-  f.planes_[near] = Plane::from_coefficients(row(3) + row(2));
-  f.planes_[far] = Plane::from_coefficients(row(3) - row(2));
+  f.planes_[left] = plane(row(3) + row(0));
+  f.planes_[right] = plane(row(3) - row(0));
+  f.planes_[bottom] = plane(row(3) + row(1));
+  f.planes_[top] = plane(row(3) - row(1));
+  f.planes_[near] = plane(clip.reversed_z ? z_high : z_low);
+  f.planes_[far] = plane(clip.reversed_z ? z_low : z_high);
   return f;
 }
 

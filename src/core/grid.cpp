@@ -162,6 +162,7 @@ void UniformGrid::insert(ObjectId id, const Aabb& bounds) {
 }
 
 void UniformGrid::update(ObjectId id, const Aabb& bounds) {
+  if (id >= object_bounds_.size()) return insert(id, bounds);  // an object added to the scene
   if (object_bounds_[id] == bounds) return;
   const Range old = object_cells_[id];
   const Range now = range_of(bounds);

@@ -7,6 +7,7 @@
 
 #include <glm/gtc/matrix_transform.hpp>
 
+#include <algorithm>
 #include <cassert>
 #include <cmath>
 
@@ -62,7 +63,24 @@ MeshId Scene::add_mesh(Mesh mesh) {
   mesh_triangles_ += mesh.triangle_count();
   mesh_bounds_.push_back(mesh.bounds());
   mesh_area_.push_back(mesh.surface_area());
+  mesh_triangle_count_.push_back(std::uint32_t(mesh.triangle_count()));
   meshes_.push_back(std::move(mesh));
+  return MeshId(meshes_.size() - 1);
+}
+
+MeshId Scene::add_mesh(const MeshInfo& info) {
+  const auto finite = [](const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); };
+  if (!info.bounds.empty() && !(finite(info.bounds.min) && finite(info.bounds.max)))
+    throw InputError(fmt::format("scene {}: a mesh's bounds ({}, {}, {}) - ({}, {}, {}) must be finite", name_,
+                                 info.bounds.min.x, info.bounds.min.y, info.bounds.min.z, info.bounds.max.x,
+                                 info.bounds.max.y, info.bounds.max.z));
+  if (!(info.surface_area >= 0.0) || !std::isfinite(info.surface_area))
+    throw InputError(fmt::format("scene {}: a mesh's surface area {} must be a finite number >= 0", name_,
+                                 info.surface_area));
+  mesh_bounds_.push_back(info.bounds);
+  mesh_area_.push_back(info.surface_area);
+  mesh_triangle_count_.push_back(info.triangles);
+  meshes_.emplace_back();  // no vertices: the engine draws it
   return MeshId(meshes_.size() - 1);
 }
 
@@ -71,14 +89,79 @@ MaterialId Scene::add_material(Material material) {
   return MaterialId(materials_.size() - 1);
 }
 
+namespace {
+
+bool finite(const glm::mat4& m) {
+  for (int c = 0; c < 4; ++c)
+    for (int r = 0; r < 4; ++r)
+      if (!std::isfinite(m[c][r])) return false;
+  return true;
+}
+
+}  // namespace
+
+void Scene::check_object(ObjectId id, const char* what) const {
+  if (id >= objects_.size())
+    throw InputError(fmt::format("scene {}: {} object {}: no such object (ids 0 to {})", name_, what, id,
+                                 objects_.size() == 0 ? 0 : objects_.size() - 1));
+  if (objects_[id].removed)
+    throw InputError(fmt::format("scene {}: {} object {}: it was removed", name_, what, id));
+}
+
+void Scene::note_moved(ObjectId id) {
+  ++placement_revision_;
+  if (moved_.size() >= std::max<std::size_t>(2 * objects_.size(), 64)) clear_moved();  // bounded: consumers rescan
+  moved_.push_back(id);
+}
+
 ObjectId Scene::add_object(MeshId mesh, MaterialId material, const glm::mat4& transform,
                            OccluderClass occluder) {
-  assert(mesh < meshes_.size() && material < materials_.size());
-  if (objects_.size() >= caps_.objects)
-    throw InputError(fmt::format("scene {}: more than {} objects, the limit (occull::limits::objects)", name_,
-                                 caps_.objects));
-  objects_.push_back(make_object(mesh, material, transform, occluder));
-  return ObjectId(objects_.size() - 1);
+  if (mesh >= meshes_.size())
+    throw InputError(fmt::format("scene {}: mesh {} does not exist ({} meshes)", name_, mesh, meshes_.size()));
+  if (material >= materials_.size())
+    throw InputError(fmt::format("scene {}: material {} does not exist ({} materials)", name_, material,
+                                 materials_.size()));
+  if (!finite(transform))
+    throw InputError(fmt::format("scene {}: a new object's transform has an entry that is not finite", name_));
+  ObjectId id;
+  if (!free_ids_.empty()) {
+    id = free_ids_.back();
+    free_ids_.pop_back();
+    objects_[id] = make_object(mesh, material, transform, occluder);
+  } else {
+    if (objects_.size() >= caps_.objects)
+      throw InputError(fmt::format("scene {}: more than {} objects, the limit (occull::limits::objects)", name_,
+                                   caps_.objects));
+    objects_.push_back(make_object(mesh, material, transform, occluder));
+    id = ObjectId(objects_.size() - 1);
+  }
+  ++layout_revision_;
+  note_moved(id);
+  return id;
+}
+
+void Scene::set_transform(ObjectId id, const glm::mat4& transform) {
+  check_object(id, "set_transform of");
+  if (!finite(transform))
+    throw InputError(fmt::format("scene {}: set_transform of object {}: the transform has an entry that is not finite",
+                                 name_, id));
+  Object& o = objects_[id];
+  o.transform = transform;
+  o.bounds = transform_box(mesh_bounds_[o.mesh], transform);
+  note_moved(id);
+}
+
+void Scene::remove_object(ObjectId id) {
+  check_object(id, "remove_object of");
+  Object& o = objects_[id];
+  if (o.dynamic()) std::erase(dynamic_, id);  // its Motion stays in motions(), unused
+  o.motion = -1;
+  o.removed = true;
+  o.bounds = Aabb{};
+  o.triangles = 0;
+  free_ids_.push_back(id);
+  ++layout_revision_;
+  note_moved(id);
 }
 
 Object Scene::make_object(MeshId mesh, MaterialId material, const glm::mat4& transform,
@@ -88,7 +171,7 @@ Object Scene::make_object(MeshId mesh, MaterialId material, const glm::mat4& tra
   o.material = material;
   o.transform = transform;
   o.bounds = transform_box(mesh_bounds_[mesh], transform);
-  o.triangles = std::uint32_t(meshes_[mesh].triangle_count());
+  o.triangles = mesh_triangle_count_[mesh];
   o.occluder = occluder;
   return o;
 }
@@ -100,7 +183,7 @@ ObjectId Scene::add_dynamic_object(MeshId mesh, MaterialId material, Motion moti
   motions_.push_back(std::move(motion));
   dynamic_local_.push_back(local);
   objects_[id].motion = std::int32_t(motions_.size() - 1);
-  dynamic_.push_back(id);
+  dynamic_.insert(std::upper_bound(dynamic_.begin(), dynamic_.end(), id), id);  // ascending, ids may be reused
   return id;
 }
 
@@ -109,7 +192,7 @@ void Scene::place_object(ObjectId id, MeshId mesh, MaterialId material, const gl
   assert(id < objects_.size() && !objects_[id].dynamic());
   assert(mesh < meshes_.size() && material < materials_.size());
   objects_[id] = make_object(mesh, material, transform, occluder);
-  moved_.push_back(id);
+  note_moved(id);
 }
 
 void Scene::update(double time_s) {

@@ -14,6 +14,101 @@
 
 namespace occull {
 
+namespace {
+
+void check_finite(const glm::mat4& m, const char* what) {
+  for (int c = 0; c < 4; ++c)
+    for (int r = 0; r < 4; ++r)
+      if (!std::isfinite(m[c][r]))
+        throw InputError(fmt::format("{} matrix: entry [column {}][row {}] is {}; every entry must be finite", what,
+                                     c, r, m[c][r]));
+}
+
+std::string depth_name(const ClipSpace& clip) {
+  return fmt::format("{} depth{}", clip.depth == DepthRange::zero_to_one ? "[0, 1]" : "[-1, 1]",
+                     clip.reversed_z ? ", reversed" : "");
+}
+
+}  // namespace
+
+View make_view(const glm::mat4& view, const glm::mat4& proj, int width, int height, const ClipSpace& clip) {
+  limits::check_viewport(width, height, "viewport");
+  check_finite(view, "view");
+  check_finite(proj, "projection");
+  const double view_det = double(glm::determinant(view));
+  if (!(std::abs(view_det) > 1e-12) || !std::isfinite(view_det))
+    throw InputError(fmt::format("view matrix: determinant {} — it cannot be inverted (a camera needs a position and "
+                                 "three independent axes)",
+                                 view_det));
+  const double proj_det = double(glm::determinant(proj));
+  if (!(std::abs(proj_det) > 0.0) || !std::isfinite(proj_det))
+    throw InputError(fmt::format("projection matrix: determinant {} — a singular projection maps space onto a plane",
+                                 proj_det));
+  // glm is column-major: proj[column][row]. The row that makes w.
+  const double w_x = proj[0][3], w_y = proj[1][3], w_z = proj[2][3], w_1 = proj[3][3];
+  const bool perspective = w_x == 0.0 && w_y == 0.0 && w_z != 0.0 && w_1 == 0.0;
+  const bool orthographic = w_x == 0.0 && w_y == 0.0 && w_z == 0.0 && w_1 != 0.0;
+  if (!perspective && !orthographic)
+    throw InputError(fmt::format("projection matrix: its w row ({}, {}, {}, {}) is neither perspective (w from "
+                                 "eye-space z alone, (0, 0, -1, 0)) nor orthographic ((0, 0, 0, 1))",
+                                 w_x, w_y, w_z, w_1));
+  const double z_z = proj[2][2], z_1 = proj[3][2];
+  const double zn = clip.near_depth(), zf = clip.far_depth();
+  double near = 0.0, far = 0.0;
+  if (perspective) {
+    // Normalised depth at clip w = s (in front: s > 0) is z_z / w_z + z_1 / s.
+    // The eye distance along the view axis is s / |w_z|.
+    const double base = z_z / w_z;
+    const auto distance_at = [&](double ndc) {
+      const double denominator = ndc - base;
+      return denominator == 0.0 ? std::numeric_limits<double>::infinity() : z_1 / denominator / std::abs(w_z);
+    };
+    near = distance_at(zn);
+    far = distance_at(zf);
+    if (!(near > 0.0) || !std::isfinite(near))
+      throw InputError(fmt::format("projection matrix: its near plane (normalised depth {} with {}) lies {} scene "
+                                   "units in front of the eye; a perspective view needs it in front (> 0). Are the "
+                                   "clip conventions right (--depth, ClipSpace)?",
+                                   zn, depth_name(clip), near));
+    // Past infinity (an infinite projection with an epsilon): no far plane.
+    if (!(far > 0.0) || !std::isfinite(far)) far = std::numeric_limits<double>::infinity();
+  } else {
+    // Normalised depth is (z_z * z + z_1) / w_1 for eye-space z.
+    const auto eye_z = [&](double ndc) { return (ndc * w_1 - z_1) / z_z; };
+    const double z_near = eye_z(zn), z_far = eye_z(zf);
+    // The view direction is the eye axis along which depth runs from near to far.
+    const double forward = z_far > z_near ? 1.0 : -1.0;
+    near = forward * z_near;
+    far = forward * z_far;
+  }
+  if (!(far > near))
+    throw InputError(fmt::format("projection matrix: near {} and far {} scene units with {}: depth must grow from the "
+                                 "near plane to the far plane",
+                                 near, far, depth_name(clip)));
+  View v;
+  v.view = view;
+  v.proj = proj;
+  v.view_proj = proj * view;
+  v.clip = clip;
+  v.eye = glm::vec3(glm::inverse(view)[3]);
+  v.frustum = Frustum::from_view_projection(v.view_proj, clip);
+  v.width = width;
+  v.height = height;
+  v.orthographic = orthographic;
+  v.near = float(near);
+  v.far = float(far);
+  // The near-plane rectangle's corners, back in eye space.
+  const glm::mat4 unproject = glm::inverse(proj);
+  float radius = 0.0f;
+  for (const float x : {-1.0f, 1.0f})
+    for (const float y : {-1.0f, 1.0f}) {
+      const glm::vec4 p = unproject * glm::vec4(x, y, float(zn), 1.0f);
+      radius = std::max(radius, glm::length(glm::vec3(p) / p.w));
+    }
+  v.near_radius = radius * (1.0f + 1e-5f);  // a hair beyond float rounding: a box closer is visible untested
+  return v;
+}
+
 View make_view(const CameraPose& pose, const Lens& lens, int width, int height) {
   limits::check_viewport(width, height, "viewport");
   const glm::vec3& p = pose.position;
@@ -29,27 +124,17 @@ View make_view(const CameraPose& pose, const Lens& lens, int width, int height) 
     throw InputError(fmt::format("lens near {} far {}: needs 0 < near < far < infinity (a near plane of 0 leaves "
                                  "the depth buffer no precision)",
                                  lens.near, lens.far));
-  View v;
-  v.eye = pose.position;
   const float cp = std::cos(pose.pitch);
   const glm::vec3 forward(-std::sin(pose.yaw) * cp, std::sin(pose.pitch), -std::cos(pose.yaw) * cp);
-  v.view = glm::lookAt(pose.position, pose.position + forward, glm::vec3(0, 1, 0));
-  v.proj = glm::perspective(glm::radians(lens.fov_y_degrees), float(width) / float(height),
-                            lens.near, lens.far);
-  v.view_proj = v.proj * v.view;
-  v.frustum = Frustum::from_view_projection(v.view_proj);
-  v.width = width;
-  v.height = height;
+  View v = make_view(glm::lookAt(pose.position, pose.position + forward, glm::vec3(0, 1, 0)),
+                     glm::perspective(glm::radians(lens.fov_y_degrees), float(width) / float(height), lens.near,
+                                      lens.far),
+                     width, height);
+  // The pose's own numbers, free of the matrices' rounding.
+  v.eye = pose.position;
   v.near = lens.near;
   v.far = lens.far;
   return v;
-}
-
-float near_plane_radius(const View& view) {
-  // proj[0][0] = 1 / (aspect * tan(fov/2)), proj[1][1] = 1 / tan(fov/2).
-  const float half_w = view.near / view.proj[0][0];
-  const float half_h = view.near / view.proj[1][1];
-  return std::sqrt(view.near * view.near + half_w * half_w + half_h * half_h);
 }
 
 CameraPath::CameraPath(std::string name, std::string description, std::vector<Key> keys)

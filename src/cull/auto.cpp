@@ -126,6 +126,15 @@ class AutoCuller final : public Culler {
     schedule_.finished((measured.frame_ms > 0.0 ? measured.frame_ms : own_ms_) / content_);
   }
 
+  void release(Backend& backend) override {
+    for (auto& c : candidates_) c->release(backend);
+  }
+  [[nodiscard]] std::size_t queries_held() const override {
+    std::size_t n = 0;
+    for (const auto& c : candidates_) n += c->queries_held();
+    return n;
+  }
+
  private:
   SceneIndex index_;
   std::vector<ObjectId> in_frustum_;

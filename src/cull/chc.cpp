@@ -35,7 +35,8 @@ class ChcCuller final : public Culler {
 
   FrameStats render_frame(const View& view, Backend& backend) override {
     ++frame_;
-    if (state_.size() != index_.bvh.size()) state_.assign(index_.bvh.size(), NodeState{});
+    seen_.begin(index_.scene);
+    if (seen_.rebuilt(index_.bvh)) carry_over(state_, index_.bvh, seen_, frame_ - 1);
     f_.begin(view, backend);
 
     queue_.push(index_.bvh, Bvh::root(), view.eye);
@@ -76,7 +77,7 @@ class ChcCuller final : public Culler {
         traverse(n);
       }
     }
-    return f_.stats;
+    return f_.end();
   }
 
  private:
@@ -109,6 +110,7 @@ class ChcCuller final : public Culler {
       objects_.clear();
       append_objects_in_frustum(index_, n, *f_.view, objects_);
       if (!objects_.empty()) f_.backend->render(objects_);
+      seen_.drawn(objects_, frame_);
     } else {
       queue_.push(index_.bvh, Bvh::left(n), f_.view->eye);
       queue_.push(index_.bvh, index_.bvh.right(n), f_.view->eye);
@@ -119,6 +121,7 @@ class ChcCuller final : public Culler {
   CommonOptions common_;
   std::uint32_t skip_;
   std::vector<NodeState> state_;
+  ObjectVisibility seen_;  // what was drawn, for state_ after a rebuild of the hierarchy
   std::uint32_t frame_ = 0;
 
   // Per frame.

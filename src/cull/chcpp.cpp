@@ -138,8 +138,9 @@ class ChcppCuller final : public Culler {
 
   FrameStats render_frame(const View& view, Backend& backend) override {
     ++frame_;
-    if (state_.size() != index_.bvh.size()) {
-      state_.assign(index_.bvh.size(), NodeState{});
+    seen_.begin(index_.scene);
+    if (seen_.rebuilt(index_.bvh)) {
+      carry_over(state_, index_.bvh, seen_, frame_ - 1);
       gate_ = EnteringGate(reset_nodes(), config_.enter_p_min);
     }
     f_.begin(view, backend);
@@ -173,7 +174,7 @@ class ChcppCuller final : public Culler {
     }
     flush_render_queue();
     while (!query_queue_.empty()) handle_returned_query();
-    return f_.stats;
+    return f_.end();
   }
 
  private:
@@ -289,6 +290,7 @@ class ChcppCuller final : public Culler {
   void flush_render_queue() {
     if (render_queue_.empty()) return;
     f_.backend->render(render_queue_);
+    seen_.drawn(render_queue_, frame_);
     render_queue_.clear();
     render_queue_triangles_ = 0;
   }
@@ -400,6 +402,7 @@ class ChcppCuller final : public Culler {
   ChcppConfig config_;
   VisibilityPersistence persistence_;
   std::vector<NodeState> state_;
+  ObjectVisibility seen_;  // what was drawn, for state_ after a rebuild of the hierarchy
   std::uint32_t frame_ = 0;
   std::uint64_t random_;
   std::vector<std::uint32_t> region_;  // the gate's region of each node

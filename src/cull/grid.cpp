@@ -84,18 +84,16 @@ class GridCuller final : public Culler {
   GridCuller(const SceneIndex& index, const GridConfig& config, std::shared_ptr<UniformGrid> grid,
              std::shared_ptr<QueryBudget> budget = nullptr, int view = 0)
       : scene_(index.scene), config_(config), grid_(std::move(grid)), budget_(std::move(budget)), view_(view),
-        drawn_(index.scene.objects().size(), ~std::uint64_t(0)), rng_(config.seed) {}
-
-  ~GridCuller() override {
-    if (!backend_) return;
-    for (const Pending& p : pending_)
-      if (!p.settled) (void)backend_->result(p.query);
-  }
+        drawn_(index.scene.objects().size(), ~std::uint64_t(0)),
+        seen_placement_(index.scene.placement_revision()), rng_(config.seed) {}
 
   FrameStats render_frame(const View& view, Backend& backend) override {
     FrameStats stats;
-    backend_ = &backend;
     for (ObjectId id : scene_.dynamic_objects()) grid_->update(id, scene_.object(id).bounds);
+    // What the engine moved, added or removed (the grid may be shared: updates are idempotent).
+    seen_placement_ = scene_.for_each_changed_since(
+        seen_placement_, [&](ObjectId id) { grid_->update(id, scene_.object(id).bounds); });
+    if (drawn_.size() < scene_.objects().size()) drawn_.resize(scene_.objects().size(), ~std::uint64_t(0));
     if (cells_.size() < grid_->occupied()) cells_.resize(grid_->occupied());
     gather(backend);
     ++frame_;
@@ -255,6 +253,13 @@ class GridCuller final : public Culler {
 
   [[nodiscard]] std::span<const CullRegion> regions() const override { return regions_; }
 
+  // The last frame's queries are read now and kept as the next frame's
+  // gather() would keep them.
+  void release(Backend& backend) override { gather(backend); }
+  [[nodiscard]] std::size_t queries_held() const override {
+    return std::size_t(std::count_if(pending_.begin(), pending_.end(), [](const Pending& p) { return !p.settled; }));
+  }
+
   bool in_one_cell(ObjectId id) const {
     const Aabb& b = scene_.object(id).bounds;
     return grid_->geometry().cell_of(b.min) == grid_->geometry().cell_of(b.max);
@@ -277,13 +282,13 @@ class GridCuller final : public Culler {
   GridTraversal traversal_;
   std::vector<Cell> cells_;             // per occupied cell
   std::vector<std::uint64_t> drawn_;    // per object: last frame it was drawn (once per frame)
+  std::uint64_t seen_placement_;        // Scene::placement_revision() the grid follows
   std::vector<Pending> pending_;        // this frame's queries, read next frame
   std::vector<ObjectId> prepass_, inside_, colour_;
   std::vector<CullRegion> regions_;     // this frame's cells (Culler::regions)
   std::uint64_t frame_ = 0;
   int capped_frames_ = 0;               // consecutive frames that hit the cap
   std::mt19937 rng_;
-  Backend* backend_ = nullptr;          // of the last frame, to drain running queries
 };
 
 }  // namespace

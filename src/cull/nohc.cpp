@@ -98,28 +98,18 @@ class NohcCuller final : public Culler {
   NohcCuller(const SceneIndex& index, const NohcConfig& config, HardwareProfile profile)
       : index_(index), config_(config), hw_(std::move(profile)), nodes_(index.bvh.size()),
         submitter_(config.flush_every) {
-    // Per node: draws, triangles, triangle-weighted shading cost, object surface area.
-    const Bvh& bvh = index.bvh;
-    for (NodeId n = NodeId(bvh.size()); n-- > 0;) {
-      NodeInfo& info = nodes_[n];
-      double weighted = 0.0;
-      for (ObjectId id : bvh.objects(n)) {
-        const Object& o = index.scene.object(id);
-        info.area += index.scene.object_surface_area(id);
-        weighted += double(o.triangles) * double(index.scene.material(o.material).shading_cost);
-      }
-      info.shading = bvh.node(n).triangles > 0 ? weighted / double(bvh.node(n).triangles) : 0.0;
-    }
-    levels_ = config.levels > 0.0 ? config.levels : std::log2(double(bvh.size()) + 1.0);
+    describe_nodes();
     max_parallel_ = config.max_parallel > 0 ? config.max_parallel : std::max(1, hw_.max_parallel_queries());
   }
 
   FrameStats render_frame(const View& view, Backend& backend) override {
     ++frame_;
-    if (nodes_.size() != index_.bvh.size()) nodes_.assign(index_.bvh.size(), NodeInfo{});
+    // A rebuilt hierarchy starts over (conservative: only queries cull); a
+    // changed set of objects changes the nodes' areas and shading.
+    const bool rebuilt = generation_ != index_.bvh.generation();
+    if (rebuilt || layout_ != index_.scene.layout_revision()) describe_nodes(rebuilt);
     f_.begin(view, backend);
     frustum_.begin(index_.bvh, view);
-    fov_y_ = 2.0 * std::atan(1.0 / double(view.proj[1][1]));
     c_scr_ = 0.0;
 
     distance_queue_.push(index_.bvh, Bvh::root(), view.eye);
@@ -138,10 +128,31 @@ class NohcCuller final : public Culler {
       visit(n);
     }
     flush_render_queue();
-    return f_.stats;
+    return f_.end();
   }
 
  private:
+  // Per node: triangle-weighted shading cost and object surface area (and,
+  // with `forget`, a fresh temporal state).
+  void describe_nodes(bool forget = true) {
+    const Bvh& bvh = index_.bvh;
+    if (forget || nodes_.size() != bvh.size()) nodes_.assign(bvh.size(), NodeInfo{});
+    for (NodeId n = NodeId(bvh.size()); n-- > 0;) {
+      NodeInfo& info = nodes_[n];
+      double weighted = 0.0;
+      info.area = 0.0;
+      for (ObjectId id : bvh.objects(n)) {
+        const Object& o = index_.scene.object(id);
+        info.area += index_.scene.object_surface_area(id);
+        weighted += double(o.triangles) * double(index_.scene.material(o.material).shading_cost);
+      }
+      info.shading = bvh.node(n).triangles > 0 ? weighted / double(bvh.node(n).triangles) : 0.0;
+    }
+    levels_ = config_.levels > 0.0 ? config_.levels : std::log2(double(bvh.size()) + 1.0);
+    generation_ = bvh.generation();
+    layout_ = index_.scene.layout_revision();
+  }
+
   struct NodeInfo {
     double area = 0.0;     // object surface area in the subtree
     double shading = 0.0;  // triangle-weighted mean shading cost
@@ -202,8 +213,7 @@ class NohcCuller final : public Culler {
         i.c_bb = projected_area(box, f_.view->view_proj, f_.view->width, f_.view->height) /
                  (double(f_.view->width) * double(f_.view->height));
       } else {
-        i.c_bb = bbox_screen_fraction(box.surface_area(), distance(f_.view->eye, box), f_.view->width,
-                                      f_.view->height, fov_y_);
+        i.c_bb = bbox_screen_fraction(box.surface_area(), distance(f_.view->eye, box), *f_.view);
       }
       i.cost_frame = frame_;
     }
@@ -344,7 +354,8 @@ class NohcCuller final : public Culler {
   // Per frame.
   FrameContext f_;
   FrustumCache frustum_;
-  double fov_y_ = 1.0;
+  std::uint64_t generation_ = 0;  // Bvh::generation() of nodes_
+  std::uint64_t layout_ = 0;      // Scene::layout_revision() of nodes_
   double c_scr_ = 0.0;
   double model_p_occl_ = 0.0;  // the model's p_occl of the last estimate, before calibration
   DistanceQueue distance_queue_;

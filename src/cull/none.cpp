@@ -6,18 +6,25 @@ namespace {
 
 class NoneCuller final : public Culler {
  public:
-  explicit NoneCuller(const SceneIndex& index) {
-    all_.reserve(index.scene.objects().size());
-    for (ObjectId id = 0; id < index.scene.objects().size(); ++id) all_.push_back(id);
-  }
+  explicit NoneCuller(const SceneIndex& index) : scene_(index.scene) {}
 
   FrameStats render_frame(const View&, Backend& backend) override {
+    if (!listed_ || layout_ != scene_.layout_revision()) {  // objects added or removed
+      all_.clear();
+      for (ObjectId id = 0; id < scene_.objects().size(); ++id)
+        if (scene_.alive(id)) all_.push_back(id);
+      layout_ = scene_.layout_revision();
+      listed_ = true;
+    }
     backend.render(all_);
     return {};
   }
 
  private:
-  std::vector<ObjectId> all_;
+  const Scene& scene_;
+  std::vector<ObjectId> all_;  // every object alive
+  std::uint64_t layout_ = 0;
+  bool listed_ = false;
 };
 
 }  // namespace

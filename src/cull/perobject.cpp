@@ -15,6 +15,8 @@
 #include "cullers.hpp"
 #include "traversal.hpp"
 
+#include <algorithm>
+
 namespace occull::detail {
 namespace {
 
@@ -33,7 +35,11 @@ class PerObjectCuller final : public Culler {
   FrameStats render_frame(const View& view, Backend& backend) override {
     FrameStats stats;
     ++frame_;
-    backend_ = &backend;
+    if (state_.size() < index_.scene.objects().size()) {  // objects added: unknown, so tested
+      State fresh;
+      fresh.frames_without_test = interval_;
+      state_.resize(index_.scene.objects().size(), fresh);
+    }
     in_frustum_.clear();
     collect_in_frustum_front_to_back(index_, view, in_frustum_, stats);
     const float radius = near_plane_radius(view);
@@ -91,12 +97,17 @@ class PerObjectCuller final : public Culler {
     return stats;
   }
 
-  // Queries still running belong to the backend: read them so it can reuse
-  // them. Precondition (as for every culler): the backend outlives the culler.
-  ~PerObjectCuller() override {
-    if (!backend_) return;
-    for (State& s : state_)
-      if (s.started) (void)backend_->result(s.query);
+  // A running query is read now; its answer counts as it would have when
+  // read in a later frame.
+  void release(Backend& backend) override {
+    for (State& s : state_) {
+      if (!s.started) continue;
+      s.started = false;
+      s.frames_without_test = backend.result(s.query) > threshold_ ? 0 : interval_;
+    }
+  }
+  [[nodiscard]] std::size_t queries_held() const override {
+    return std::size_t(std::count_if(state_.begin(), state_.end(), [](const State& s) { return s.started; }));
   }
 
  private:
@@ -120,7 +131,6 @@ class PerObjectCuller final : public Culler {
   std::uint64_t threshold_;
   std::vector<State> state_;
   std::uint32_t frame_ = 0;
-  Backend* backend_ = nullptr;  // of the last frame, to drain running queries
   std::vector<ObjectId> in_frustum_, occludees_;
 };
 

@@ -52,9 +52,7 @@ class TilesCuller final : public Culler {
     view_ = &view;
     near_radius_ = near_plane_radius(view);
     cache_.begin_frame(++frame_, stats);
-    // Queries whose results were not ready at the last frame's end: freed now.
-    for (QueryId q : stale_) (void)backend.result(q);
-    stale_.clear();
+    release(backend);  // the queries whose results were not ready at the last frame's end
 
     pending_.clear();
     postponed_.clear();
@@ -69,9 +67,19 @@ class TilesCuller final : public Culler {
     cache_.end_frame();
     prune();
     stats_ = nullptr;
+    backend_ = nullptr;  // this frame's only: queries left over are in stale_
+    view_ = nullptr;
     return stats;
   }
   [[nodiscard]] std::span<const CullRegion> regions() const override { return cache_.regions(); }
+
+  // The postponed queries given up on at the last frame's end (their cells
+  // were already taken as hidden): read and dropped, as the next frame would.
+  void release(Backend& backend) override {
+    for (QueryId q : stale_) (void)backend.result(q);
+    stale_.clear();
+  }
+  [[nodiscard]] std::size_t queries_held() const override { return stale_.size(); }
 
  private:
   struct CellState {
@@ -177,8 +185,8 @@ class TilesCuller final : public Culler {
   std::vector<Pending> postponed_; // P
   std::vector<QueryId> stale_;     // postponed queries given up on at the last frame's end
   FrameStats* stats_ = nullptr;
-  Backend* backend_ = nullptr;
-  const View* view_ = nullptr;
+  Backend* backend_ = nullptr;  // during render_frame only
+  const View* view_ = nullptr;  // during render_frame only
   float near_radius_ = 0.0f;
 };
 

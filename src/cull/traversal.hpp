@@ -49,8 +49,8 @@ inline std::array<NodeId, 2> children_front_to_back(const Bvh& bvh, NodeId n, co
 /// view and the backend, and the near-plane radius of the eye-inside rule.
 struct FrameContext {
   FrameStats stats;
-  const View* view = nullptr;
-  Backend* backend = nullptr;
+  const View* view = nullptr;   ///< during a frame only
+  Backend* backend = nullptr;   ///< during a frame only: no culler keeps a backend between frames
   float near_radius = 0.0f;
 
   void begin(const View& v, Backend& b) {
@@ -59,7 +59,63 @@ struct FrameContext {
     backend = &b;
     near_radius = near_plane_radius(v);
   }
+  /// Ends the frame: forgets the view and backend; returns the frame's stats.
+  FrameStats end() {
+    view = nullptr;
+    backend = nullptr;
+    return stats;
+  }
 };
+
+/// Per-object visibility that outlives the hierarchy's nodes: which objects a
+/// culler drew in which frame. When the BVH is rebuilt (Bvh::generation),
+/// a culler that keeps state per node starts its new nodes from it: a leaf
+/// was visible last frame when one of its objects was drawn then, and so
+/// were its ancestors. Objects added since are simply unknown (not visible).
+class ObjectVisibility {
+ public:
+  /// Call once per frame before drawing; sizes the record to the scene.
+  void begin(const Scene& scene) {
+    if (drawn_.size() < scene.objects().size()) drawn_.resize(scene.objects().size(), kNever);
+  }
+  void drawn(std::span<const ObjectId> objects, std::uint32_t frame) {
+    for (ObjectId id : objects) drawn_[id] = frame;
+  }
+  [[nodiscard]] bool drawn_in(ObjectId id, std::uint32_t frame) const {
+    return id < drawn_.size() && drawn_[id] == frame;
+  }
+  /// Whether the hierarchy changed since the last call (and remembers it).
+  [[nodiscard]] bool rebuilt(const Bvh& bvh) {
+    const bool changed = bvh.generation() != generation_ || !known_;
+    generation_ = bvh.generation();
+    known_ = true;
+    return changed;
+  }
+
+ private:
+  std::vector<std::uint32_t> drawn_;  // per object: last frame drawn (kNever: never)
+  std::uint64_t generation_ = 0;
+  bool known_ = false;
+};
+
+/// Node states for a rebuilt hierarchy from what a culler drew in `frame`
+/// (its last): a leaf whose objects include one drawn then was visible, and
+/// so were its ancestors; every node counts as visited in `frame`, so the
+/// others are queried as CHC queries the previously invisible. Conservative
+/// whatever `seen` says: only queries cull.
+inline void carry_over(std::vector<NodeState>& state, const Bvh& bvh, const ObjectVisibility& seen,
+                       std::uint32_t frame) {
+  state.assign(bvh.size(), NodeState{});
+  for (NodeState& s : state) s.last_visited = frame;
+  for (NodeId n = 0; n < NodeId(bvh.size()); ++n) {
+    if (!bvh.node(n).is_leaf()) continue;
+    for (ObjectId id : bvh.objects(n))
+      if (seen.drawn_in(id, frame)) {
+        pull_up_visibility(state, bvh, n);
+        break;
+      }
+  }
+}
 
 /// Traversal queue ordered by distance from the eye to the node's box,
 /// nearest first (ties: lower node id first, so traversal is deterministic).

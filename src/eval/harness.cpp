@@ -174,9 +174,6 @@ FrameStats Session::run_frame(Culler& culler, const View& view, double time_s, F
   const auto t0 = Clock::now();
   if (!bundle_.world) bvh_.refit(bundle_.scene);
   renderer_->begin_frame(view);
-  // A logged frame renders through the session's logger, which lives as
-  // long as the backend it wraps: a culler may read this frame's queries
-  // through it later (in its next frame, or when it is destroyed).
   if (log && !logger_) logger_ = std::make_unique<LoggingBackend>(this->backend());
   if (logger_) logger_->log_into(log);
   Backend& backend = log ? static_cast<Backend&>(*logger_) : this->backend();
@@ -213,6 +210,18 @@ FrameStats Session::run_frame(Culler& culler, const View& view, double time_s, F
   context_->check("the end of a frame");
   culler.frame_finished(s);
   return s;
+}
+
+void Session::release(Culler& culler) { culler.release(backend()); }
+
+void Session::check_queries_returned(std::string_view who) const {
+  const std::size_t abandoned = guard_ ? guard_->abandoned() : 0;
+  const std::size_t in_flight = renderer_->queries_in_flight();
+  if (in_flight > abandoned)
+    detail::invariant_violated({scene_spec_, std::string(who), 0}, "queries-returned",
+                               fmt::format("{} queries still in flight after the run's cullers were released ({} of "
+                                           "them given up on by the stall guard)",
+                                           in_flight, abandoned));
 }
 
 std::vector<FrameTruth> Session::ground_truth(const CameraPath& path, int frames,
@@ -633,6 +642,9 @@ struct ViewCullers {
   void begin_frame() {
     if (grid) grid->begin_frame();
   }
+  void release(Session& session, int views) {
+    for (int k = 0; k < views; ++k) session.release(view(k));
+  }
 };
 
 // One algorithm over a split-screen frame sequence: the views render one
@@ -652,6 +664,7 @@ void run_split_screen(Session& session, const std::string& name, const BenchConf
         (void)session.run_path_frame(warm.view(k), *paths[std::size_t(k)], f, config.frames, truth_of(k));
       if (progress) progress(label, w, config.warmup, true);
     }
+    warm.release(session, views);
   }
   const bool conservative = is_conservative(parse_algorithm_spec(name, config.options));
   ViewCullers cullers(session, name, config.options, views);
@@ -678,6 +691,8 @@ void run_split_screen(Session& session, const std::string& name, const BenchConf
     whole.frames.push_back(sum);
     if (progress) progress(label, f, config.frames, false);
   }
+  cullers.release(session, views);
+  session.check_queries_returned(label);
   for (int k = 0; k < views; ++k) {
     each[std::size_t(k)].longest_miss_frames = misses[std::size_t(k)].longest();
     whole.longest_miss_frames = std::max(whole.longest_miss_frames, misses[std::size_t(k)].longest());
@@ -835,6 +850,7 @@ BenchResult run_bench(const BenchConfig& config, const ProgressFn& progress) {
           (void)session.run_path_frame(*warm, path, f, config.frames, truth_ptr);
           if (progress) progress(label, k, config.warmup, true);
         }
+        session.release(*warm);
       }
       auto culler = session.make(name, config.options);
       AlgorithmRun run = session.run_path(name, *culler, path, config.frames, truth_ptr,
@@ -842,6 +858,8 @@ BenchResult run_bench(const BenchConfig& config, const ProgressFn& progress) {
                                             if (progress) progress(label, k, n, w);
                                           },
                                           config.model);
+      session.release(*culler);
+      session.check_queries_returned(label);
       run.repeat = rep;
       run.conservative = is_conservative(parse_algorithm_spec(name, config.options));
       result.runs.push_back(std::move(run));

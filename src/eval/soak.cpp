@@ -75,6 +75,8 @@ void soak_one(Session& session, SoakRun& run, const SoakConfig& c, const CameraP
     ms.clear();
     queries = 0;
   }
+  session.release(*culler);
+  session.check_queries_returned(name);
   judge_soak_run(run, c.tolerance);
   if (live) *live << soak_run_verdict(run) << std::flush;
 }

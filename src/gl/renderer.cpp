@@ -269,6 +269,15 @@ struct Renderer::Impl {
   // Which queries the device has been handed (a flush since their issue):
   // polling or reading one that was not makes the driver flush.
   std::vector<std::uint64_t> query_serial;  // QueryId -> issue_serial when issued
+  std::vector<std::uint8_t> query_live;     // QueryId -> issued and not yet read
+  // Backend's precondition "q in flight", checked on every use of a query:
+  // a query read twice would be freed twice and later handed to two users.
+  void check_in_flight(QueryId q, const char* call) const {
+    if (q >= query_live.size() || !query_live[q])
+      throw std::logic_error(fmt::format("gl::Renderer::{}: query {} is not in flight ({})", call, q,
+                                         q >= query_live.size() ? "never issued by this renderer"
+                                                                : "already read, or issued by another renderer"));
+  }
   std::uint64_t issue_serial = 0;           // queries issued so far
   std::uint64_t flushed_serial = 0;         // issue_serial at the last flush
   void note_flush_for(QueryId q, BackendStats& stats) {
@@ -277,6 +286,8 @@ struct Renderer::Impl {
     flushed_serial = issue_serial;
   }
   std::vector<QueryId> free_queries;
+  std::uint64_t uploaded_revision = 0;  // Scene::placement_revision() of the transforms on the device
+  std::size_t object_capacity = 0;      // objects the per-object buffers hold
   std::size_t in_flight = 0;
   // Every buffer object the renderer owns.
   [[nodiscard]] std::array<GLuint, 7> buffer_names() const {
@@ -392,6 +403,8 @@ void Renderer::Impl::create_scene_buffers() {
   glCreateBuffers(1, &object_buffer);
   glNamedBufferStorage(object_buffer, GLsizeiptr(models.size() * sizeof(glm::mat4)), models.data(),
                        GL_DYNAMIC_STORAGE_BIT);
+  object_capacity = objects.size();
+  uploaded_revision = scene.placement_revision();
 
   for (const Material& m : scene.materials()) {
     glm::vec4 color = m.color;
@@ -631,10 +644,11 @@ void Renderer::Impl::upload_dynamic_transforms() {
     glNamedBufferSubData(object_buffer, GLintptr(id * sizeof(glm::mat4)), sizeof(glm::mat4),
                          glm::value_ptr(scene.object(id).transform));
   }
-  for (ObjectId id : scene.moved_objects()) {  // placed anew (a tiled world's window moved)
+  // Placed anew (a tiled world's window moved) or moved by the engine.
+  uploaded_revision = scene.for_each_changed_since(uploaded_revision, [&](ObjectId id) {
     glNamedBufferSubData(object_buffer, GLintptr(id * sizeof(glm::mat4)), sizeof(glm::mat4),
                          glm::value_ptr(scene.object(id).transform));
-  }
+  });
 }
 
 Renderer::Renderer(const Scene& scene, const RendererOptions& options)
@@ -670,6 +684,10 @@ Renderer::~Renderer() {
 // Context state, camera and per-frame bookkeeping of a pass over `view`;
 // the targets keep what they hold.
 void Renderer::Impl::prepare_pass(const View& view) {
+  if (scene.objects().size() > object_capacity)
+    throw std::logic_error(fmt::format("gl::Renderer: the scene has {} objects, {} more than when the renderer was "
+                                       "made; objects added later need a new renderer (ids removed and reused are fine)",
+                                       scene.objects().size(), scene.objects().size() - object_capacity));
   establish_frame_state();
   upload_dynamic_transforms();
   glProgramUniformMatrix4fv(scene_program, u_scene_view_proj, 1, GL_FALSE, glm::value_ptr(view.view_proj));
@@ -772,7 +790,7 @@ void Renderer::render(std::span<const ObjectId> objects) {
 
 void Renderer::render_conditional(std::span<const ObjectId> objects, QueryId q, ConditionalWait wait) {
   Impl& g = *impl_;
-  assert(q < g.query_names.size());
+  g.check_in_flight(q, "render_conditional");
   ScopedTimer timer(stats_.backend_ms);
   ++stats_.render_flushes;
   g.opaque.clear();
@@ -809,11 +827,13 @@ QueryId Renderer::issue_query(std::span<const Aabb> boxes) {
     q = QueryId(g.query_names.size());
     g.query_names.push_back(name);
     g.query_serial.push_back(0);
+    g.query_live.push_back(0);
   } else {
     q = g.free_queries.back();
     g.free_queries.pop_back();
   }
   ++g.in_flight;
+  g.query_live[q] = 1;
   g.query_serial[q] = ++g.issue_serial;
   // A box around the eye shows only back faces: draw both sides for it.
   bool around_eye = false;
@@ -848,6 +868,7 @@ QueryId Renderer::issue_query(std::span<const Aabb> boxes) {
 
 bool Renderer::result_available(QueryId q) {
   Impl& g = *impl_;
+  g.check_in_flight(q, "result_available");
   ScopedTimer timer(stats_.backend_ms);
   GLuint available = GL_FALSE;
   g.note_flush_for(q, stats_);
@@ -858,6 +879,7 @@ bool Renderer::result_available(QueryId q) {
 
 std::uint64_t Renderer::result(QueryId q) {
   Impl& g = *impl_;
+  g.check_in_flight(q, "result");
   const auto t0 = Clock::now();
   GLuint available = GL_FALSE;
   g.note_flush_for(q, stats_);
@@ -871,6 +893,7 @@ std::uint64_t Renderer::result(QueryId q) {
   stats_.backend_ms += ms;
   if (!g.conditional.empty()) g.settle_conditional(q, samples, stats_);
   g.free_queries.push_back(q);
+  g.query_live[q] = 0;
   --g.in_flight;
   return samples;
 }

@@ -106,7 +106,12 @@ struct RendererOptions {
 ///
 /// Preconditions: a gl::Context is current on the calling thread for the
 /// renderer's whole life; `scene` outlives the renderer and keeps its
-/// objects (update() may move dynamic ones).
+/// meshes. Objects may move (update(), set_transform, place_object), be
+/// removed and have their ids reused; objects added past the count the scene
+/// had when the renderer was made are refused (std::logic_error at the next
+/// frame: make a new renderer). Query calls check that the query is in
+/// flight (issued by this renderer, not yet read) and throw
+/// std::logic_error otherwise.
 class Renderer final : public Backend {
  public:
   Renderer(const Scene& scene, const RendererOptions& options);

@@ -1,0 +1,183 @@
+// Views from an engine's matrices: every clip convention (OpenGL's [-1, 1],
+// [0, 1], reversed-Z), infinite far planes, asymmetric and orthographic
+// projections, and the refusals of bad matrices.
+#include "occull/cost_model.hpp"
+#include "occull/error.hpp"
+#include "occull/view.hpp"
+
+#include <glm/gtc/matrix_transform.hpp>
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+
+using namespace occull;
+
+namespace {
+
+constexpr float kFov = 1.0f;  // radians
+constexpr float kAspect = 16.0f / 9.0f;
+constexpr float kNear = 0.5f, kFar = 300.0f;
+const glm::mat4 kCamera = glm::lookAt(glm::vec3(3, 2, 1), glm::vec3(10, 1, -20), glm::vec3(0, 1, 0));
+
+// The same lens in four clip conventions.
+glm::mat4 gl_standard() { return glm::perspectiveRH_NO(kFov, kAspect, kNear, kFar); }
+glm::mat4 zero_to_one() { return glm::perspectiveRH_ZO(kFov, kAspect, kNear, kFar); }
+glm::mat4 gl_reversed() {
+  glm::mat4 p = gl_standard();
+  for (int c = 0; c < 4; ++c) p[c][2] = -p[c][2];  // depth negated: near 1, far -1
+  return p;
+}
+glm::mat4 zero_to_one_reversed() { return glm::perspectiveRH_ZO(kFov, kAspect, kFar, kNear); }
+// Reversed-Z with an infinite far plane: depth = near / distance.
+glm::mat4 infinite_reversed() {
+  glm::mat4 p(0.0f);
+  const float f = 1.0f / std::tan(kFov / 2.0f);
+  p[0][0] = f / kAspect;
+  p[1][1] = f;
+  p[2][3] = -1.0f;
+  p[3][2] = kNear;
+  return p;
+}
+
+void expect_same_planes(const Frustum& a, const Frustum& b, int sides, const char* what) {
+  for (int i = 0; i < sides; ++i) {
+    EXPECT_NEAR(glm::length(a.plane(i).n - b.plane(i).n), 0.0f, 1e-4f) << what << " plane " << i;
+    EXPECT_NEAR(a.plane(i).d, b.plane(i).d, 1e-3f * std::max(1.0f, std::abs(b.plane(i).d))) << what << " plane " << i;
+  }
+}
+
+}  // namespace
+
+TEST(ViewFromMatrices, EqualsThePoseViewForOpenGLMatrices) {
+  const CameraPose pose{{3, 2, 1}, 0.4f, -0.1f};
+  const Lens lens{60.0f, 0.1f, 800.0f};
+  const View a = make_view(pose, lens, 320, 180);
+  const View b = make_view(a.view, a.proj, 320, 180);
+  EXPECT_NEAR(glm::length(a.eye - b.eye), 0.0f, 1e-4f);
+  EXPECT_NEAR(b.near, lens.near, 1e-5f);
+  EXPECT_NEAR(b.far, lens.far, 1e-3f * lens.far);  // far is ill-conditioned in a float matrix
+  EXPECT_FLOAT_EQ(a.near_radius, b.near_radius);
+  EXPECT_FALSE(b.orthographic);
+  expect_same_planes(a.frustum, b.frustum, 6, "pose");
+  // The near-plane radius is the distance to a corner of the near rectangle.
+  const float half_h = lens.near * std::tan(glm::radians(lens.fov_y_degrees) / 2.0f);
+  const float half_w = half_h * 320.0f / 180.0f;
+  EXPECT_NEAR(a.near_radius, std::sqrt(lens.near * lens.near + half_w * half_w + half_h * half_h), 1e-5f);
+}
+
+TEST(ViewFromMatrices, EveryClipConventionGivesTheSameFrustumNearAndFar) {
+  const View reference = make_view(kCamera, gl_standard(), 640, 360);
+  EXPECT_NEAR(reference.near, kNear, 1e-5f);
+  EXPECT_NEAR(reference.far, kFar, 0.05f);
+  struct Case {
+    const char* name;
+    glm::mat4 proj;
+    ClipSpace clip;
+  };
+  const Case cases[] = {
+      {"[0, 1]", zero_to_one(), {DepthRange::zero_to_one, false}},
+      {"[-1, 1] reversed", gl_reversed(), {DepthRange::negative_one_to_one, true}},
+      {"[0, 1] reversed", zero_to_one_reversed(), {DepthRange::zero_to_one, true}},
+  };
+  for (const Case& c : cases) {
+    const View v = make_view(kCamera, c.proj, 640, 360, c.clip);
+    EXPECT_NEAR(v.near, kNear, 1e-4f) << c.name;
+    EXPECT_NEAR(v.far, kFar, 0.1f) << c.name;
+    EXPECT_NEAR(v.near_radius, reference.near_radius, 1e-4f) << c.name;
+    expect_same_planes(v.frustum, reference.frustum, 6, c.name);
+  }
+}
+
+TEST(ViewFromMatrices, WrongConventionsAreRefusedNotMisread) {
+  // A [0, 1] reversed matrix read as OpenGL's puts the near plane behind the eye.
+  EXPECT_THROW((void)make_view(kCamera, zero_to_one_reversed(), 640, 360), InputError);
+  try {
+    (void)make_view(kCamera, gl_standard(), 640, 360, {DepthRange::zero_to_one, true});
+    FAIL() << "accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("reversed"), std::string::npos) << e.what();
+  }
+}
+
+TEST(ViewFromMatrices, InfiniteFarPlaneKeepsEveryBoxInFrontInside) {
+  const View v = make_view(kCamera, infinite_reversed(), 640, 360, {DepthRange::zero_to_one, true});
+  EXPECT_TRUE(std::isinf(v.far));
+  EXPECT_NEAR(v.near, kNear, 1e-5f);
+  const View finite = make_view(kCamera, zero_to_one_reversed(), 640, 360, {DepthRange::zero_to_one, true});
+  expect_same_planes(v.frustum, finite.frustum, 5, "infinite");  // all but the far plane
+  // Far beyond any finite far plane, straight ahead: inside.
+  const glm::vec3 ahead = v.eye + 1e6f * glm::normalize(glm::vec3(10, 1, -20) - v.eye);
+  const Aabb far_box{ahead - glm::vec3(10.0f), ahead + glm::vec3(10.0f)};
+  EXPECT_NE(v.frustum.classify(far_box), Containment::outside);
+  EXPECT_EQ(finite.frustum.classify(far_box), Containment::outside);
+  // Behind the eye: still outside.
+  const glm::vec3 behind = v.eye - 50.0f * glm::normalize(glm::vec3(10, 1, -20) - v.eye);
+  EXPECT_EQ(v.frustum.classify({behind - glm::vec3(1.0f), behind + glm::vec3(1.0f)}), Containment::outside);
+}
+
+TEST(ViewFromMatrices, AsymmetricFrustumSeesOnlyItsSide) {
+  // An eye of a stereo pair: the frustum leans right (left 0.1, right 0.5 at near 0.5).
+  const glm::mat4 proj = glm::frustum(-0.1f, 0.5f, -0.2f, 0.2f, 0.5f, 100.0f);
+  const View v = make_view(glm::mat4(1.0f), proj, 400, 200);
+  EXPECT_NEAR(v.near, 0.5f, 1e-5f);
+  // At 10 m the view spans x in [-2, 10].
+  EXPECT_NE(v.frustum.classify({{8.0f, -0.5f, -10.5f}, {9.0f, 0.5f, -9.5f}}), Containment::outside);
+  EXPECT_EQ(v.frustum.classify({{-4.0f, -0.5f, -10.5f}, {-3.0f, 0.5f, -9.5f}}), Containment::outside);
+  // Its near-plane radius reaches the farther corner (0.5, +-0.2, -0.5).
+  EXPECT_NEAR(v.near_radius, std::sqrt(0.25f + 0.04f + 0.25f), 1e-4f);
+  // The screen fraction follows the lens's real width: half that of a
+  // symmetric lens twice as wide.
+  const View wide = make_view(glm::mat4(1.0f), glm::frustum(-1.2f, 1.2f, -0.2f, 0.2f, 0.5f, 100.0f), 400, 200);
+  EXPECT_NEAR(bbox_screen_fraction(6.0, 10.0, v) / bbox_screen_fraction(6.0, 10.0, wide), 4.0, 1e-6);
+}
+
+TEST(ViewFromMatrices, OrthographicViewsHaveNoPerspective) {
+  const glm::mat4 proj = glm::ortho(-20.0f, 20.0f, -10.0f, 10.0f, -5.0f, 200.0f);
+  const View v = make_view(kCamera, proj, 400, 200);
+  EXPECT_TRUE(v.orthographic);
+  EXPECT_NEAR(v.near, -5.0f, 1e-4f);  // behind the camera: allowed in an orthographic view
+  EXPECT_NEAR(v.far, 200.0f, 1e-3f);
+  EXPECT_NEAR(v.near_radius, std::sqrt(25.0f + 400.0f + 100.0f), 1e-3f);
+  // Size on screen does not depend on distance.
+  EXPECT_DOUBLE_EQ(bbox_screen_fraction(6.0, 1.0, v), bbox_screen_fraction(6.0, 100.0, v));
+  EXPECT_NEAR(bbox_screen_fraction(6.0, 1.0, v), 1.0 / 800.0, 1e-9);  // a 1 m^2 face of a 40 x 20 screen
+  // A [0, 1] orthographic projection reads the same.
+  const View zo = make_view(kCamera, glm::orthoRH_ZO(-20.0f, 20.0f, -10.0f, 10.0f, -5.0f, 200.0f), 400, 200,
+                            {DepthRange::zero_to_one, false});
+  EXPECT_NEAR(zo.near, -5.0f, 1e-4f);
+  expect_same_planes(zo.frustum, v.frustum, 6, "orthographic [0, 1]");
+}
+
+TEST(ViewFromMatrices, SymmetricPerspectiveScreenFractionIsThePapers) {
+  const View v = make_view(kCamera, gl_standard(), 640, 360);
+  const double fov = 2.0 * std::atan(1.0 / double(v.proj[1][1]));
+  for (const double d : {1.0, 7.5, 120.0})
+    EXPECT_NEAR(bbox_screen_fraction(24.0, d, v) / bbox_screen_fraction(24.0, d, 640, 360, fov), 1.0, 1e-6) << d;
+}
+
+TEST(ViewFromMatrices, BadMatricesAreRefusedNamingTheValue) {
+  const auto refused = [](const glm::mat4& view, const glm::mat4& proj, const std::string& says, int w = 64,
+                          int h = 64) {
+    try {
+      (void)make_view(view, proj, w, h);
+      ADD_FAILURE() << "accepted; expected: " << says;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(says), std::string::npos) << e.what();
+    }
+  };
+  glm::mat4 nan_view = kCamera;
+  nan_view[3][1] = std::numeric_limits<float>::quiet_NaN();
+  refused(nan_view, gl_standard(), "view matrix: entry [column 3][row 1] is nan");
+  glm::mat4 inf_proj = gl_standard();
+  inf_proj[0][0] = std::numeric_limits<float>::infinity();
+  refused(kCamera, inf_proj, "projection matrix: entry [column 0][row 0] is inf");
+  refused(glm::mat4(0.0f), gl_standard(), "cannot be inverted");
+  glm::mat4 flat = gl_standard();
+  flat[0][0] = 0.0f;
+  refused(kCamera, flat, "singular");
+  glm::mat4 tilted = gl_standard();
+  tilted[0][3] = 0.3f;
+  refused(kCamera, tilted, "neither perspective");
+  refused(kCamera, gl_standard(), "viewport", 0, 64);
+}
