@@ -201,3 +201,65 @@ TEST(Bvh, TightBoxesOfALeafAreItsObjects) {
   bvh.gather_tight_boxes(0, 3, 10.0f, scene, boxes);
   EXPECT_EQ(boxes.size(), 2u);
 }
+
+TEST(Bvh, RefitFollowsStaticObjectsTheEngineMoves) {
+  // The static part used to be left alone: a static object moved by the
+  // engine left its ancestors' boxes stale, and cullers missed it there.
+  Scene scene = test::box_scene(random_boxes(200, 11));
+  Bvh bvh = Bvh::build(scene);
+  scene.set_transform(17, glm::translate(glm::mat4(1.0f), glm::vec3(40.0f, 5.0f, -30.0f)));
+  scene.set_transform(120, glm::translate(glm::mat4(1.0f), glm::vec3(-3.0f, 0.0f, 2.0f)));
+  bvh.refit(scene);
+  expect_valid(bvh, scene);
+}
+
+TEST(Bvh, RemovedObjectsLeaveEmptyBoxesAndReusedIdsAreRefitted) {
+  Scene scene = test::box_scene(random_boxes(100, 12));
+  Bvh bvh = Bvh::build(scene);
+  scene.remove_object(5);
+  scene.remove_object(60);
+  bvh.refit(scene);
+  expect_valid(bvh, scene);
+  EXPECT_EQ(bvh.generation(), 0u);  // no new leaves needed
+  const ObjectId again = scene.add_object(scene.object(1).mesh, 0, glm::translate(glm::mat4(1.0f), {0, 50, 0}),
+                                          OccluderClass::always);
+  EXPECT_EQ(again, 60u);  // the most recently removed id
+  bvh.refit(scene);
+  expect_valid(bvh, scene);
+  EXPECT_TRUE(bvh.node(Bvh::root()).bounds.contains(scene.object(60).bounds));
+}
+
+TEST(Bvh, ObjectsAddedPastItsCountRebuildIt) {
+  Scene scene = test::box_scene(random_boxes(50, 13));
+  Bvh bvh = Bvh::build(scene);
+  const MeshId mesh = scene.object(0).mesh;
+  scene.add_object(mesh, 0, glm::translate(glm::mat4(1.0f), {7, 0, 7}), OccluderClass::never);
+  bvh.refit(scene);
+  EXPECT_EQ(bvh.generation(), 1u);
+  expect_valid(bvh, scene);
+}
+
+TEST(Bvh, QualityStaysWithinItsFactorOfAFreshBuildUnderMotion) {
+  // 10% of 2000 objects jump around every frame for 300 frames.
+  Scene scene = test::box_scene(random_boxes(2000, 14));
+  std::vector<glm::vec3> home;
+  for (const Object& o : scene.objects()) home.push_back(o.bounds.min);
+  Bvh bvh = Bvh::build(scene);
+  std::mt19937 rng(15);
+  std::uniform_int_distribution<int> pick(0, 1999);
+  std::uniform_real_distribution<float> step(-4.0f, 4.0f);
+  std::vector<glm::vec3> offset(2000, glm::vec3(0.0f));
+  for (int frame = 0; frame < 300; ++frame) {
+    for (int k = 0; k < 200; ++k) {
+      const int id = pick(rng);
+      offset[std::size_t(id)] += glm::vec3(step(rng), 0.0f, step(rng));
+      scene.set_transform(ObjectId(id), glm::translate(glm::mat4(1.0f), offset[std::size_t(id)]));
+    }
+    bvh.refit(scene);
+    ASSERT_LE(bvh.sah_cost(), Bvh::kRebuildFactor * bvh.built_sah_cost() + 1e-9) << "frame " << frame;
+  }
+  expect_valid(bvh, scene);
+  EXPECT_GT(bvh.generation(), 0u);  // it did rebuild
+  const double fresh = Bvh::build(scene).sah_cost();
+  EXPECT_LE(bvh.sah_cost(), 1.3 * fresh);
+}

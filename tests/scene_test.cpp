@@ -1,4 +1,9 @@
+#include "occull/error.hpp"
 #include "occull/scene.hpp"
+#include "test_util.hpp"
+
+#include <algorithm>
+#include <cmath>
 
 #include <glm/gtc/matrix_transform.hpp>
 #include <gtest/gtest.h>
@@ -64,4 +69,94 @@ TEST(Scene, UpdateMovesDynamicObjectsAndTheirBounds) {
   EXPECT_NEAR(s.object(id).bounds.min.x, 20.0f, 1e-4f);
   s.update(0.0);
   EXPECT_NEAR(s.object(id).bounds.min.x, 0.0f, 1e-4f);
+}
+
+TEST(Scene, SetTransformMovesAnyObjectAndCountsAPlacement) {
+  Scene s = test::box_scene({{{0, 0, 0}, {1, 1, 1}}, {{5, 0, 0}, {6, 1, 1}}});
+  const std::uint64_t before = s.placement_revision();
+  s.set_transform(0, glm::translate(glm::mat4(1.0f), {10, 0, 0}));
+  EXPECT_EQ(s.object(0).bounds, (Aabb{{10, 0, 0}, {11, 1, 1}}));
+  EXPECT_EQ(s.placement_revision(), before + 1);
+  std::vector<ObjectId> changed;
+  EXPECT_EQ(s.for_each_changed_since(before, [&](ObjectId id) { changed.push_back(id); }), before + 1);
+  EXPECT_NE(std::find(changed.begin(), changed.end(), 0u), changed.end());
+}
+
+TEST(Scene, RemovedIdsAreEmptyAndReusedMostRecentFirst) {
+  Scene s = test::box_scene({{{0, 0, 0}, {1, 1, 1}}, {{5, 0, 0}, {6, 1, 1}}, {{9, 0, 0}, {10, 1, 1}}});
+  const MeshId mesh = s.object(0).mesh;
+  const std::uint64_t layout = s.layout_revision();
+  s.remove_object(0);
+  s.remove_object(2);
+  EXPECT_FALSE(s.alive(0));
+  EXPECT_TRUE(s.object(2).bounds.empty());
+  EXPECT_EQ(s.object(2).triangles, 0u);
+  EXPECT_EQ(s.layout_revision(), layout + 2);
+  EXPECT_EQ(s.add_object(mesh, 0, glm::mat4(1.0f), OccluderClass::never), 2u);
+  EXPECT_EQ(s.add_object(mesh, 0, glm::mat4(1.0f), OccluderClass::never), 0u);
+  EXPECT_EQ(s.add_object(mesh, 0, glm::mat4(1.0f), OccluderClass::never), 3u);
+  EXPECT_TRUE(s.alive(2));
+  EXPECT_EQ(s.object(2).bounds, (Aabb{{0, 0, 0}, {1, 1, 1}}));
+}
+
+TEST(Scene, RemovingADynamicObjectStopsItsMotion) {
+  Scene s("dyn");
+  const MeshId mesh = s.add_mesh(test::box_mesh({{-0.5f, -0.5f, -0.5f}, {0.5f, 0.5f, 0.5f}}));
+  const MaterialId mat = s.add_material({});
+  Motion m;
+  m.waypoints = {{0, 0, 0}, {10, 0, 0}};
+  const ObjectId id = s.add_dynamic_object(mesh, mat, m, OccluderClass::never);
+  s.remove_object(id);
+  s.update(1.0);
+  EXPECT_TRUE(s.object(id).bounds.empty());
+  EXPECT_TRUE(s.dynamic_objects().empty());
+}
+
+TEST(Scene, BadEngineCallsAreRefusedAndChangeNothing) {
+  Scene s = test::box_scene({{{0, 0, 0}, {1, 1, 1}}});
+  const Object before = s.object(0);
+  const std::uint64_t revision = s.placement_revision();
+  glm::mat4 nan = glm::mat4(1.0f);
+  nan[3][0] = std::nanf("");
+  EXPECT_THROW(s.set_transform(0, nan), InputError);
+  EXPECT_THROW(s.set_transform(7, glm::mat4(1.0f)), InputError);
+  EXPECT_THROW(s.remove_object(7), InputError);
+  EXPECT_THROW((void)s.add_object(9, 0, glm::mat4(1.0f), OccluderClass::never), InputError);
+  EXPECT_THROW((void)s.add_object(0, 9, glm::mat4(1.0f), OccluderClass::never), InputError);
+  EXPECT_THROW((void)s.add_object(0, 0, nan, OccluderClass::never), InputError);
+  s.remove_object(0);
+  try {
+    s.set_transform(0, glm::mat4(1.0f));
+    FAIL() << "a removed object moved";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("object 0: it was removed"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(s.remove_object(0), InputError);
+  EXPECT_EQ(s.objects().size(), 1u);
+  EXPECT_EQ(s.placement_revision(), revision + 1);  // the one removal
+  (void)before;
+}
+
+TEST(Scene, MeshesWithoutVerticesCarryBoundsTrianglesAndArea) {
+  Scene s("engine");
+  const MeshId mesh = s.add_mesh(MeshInfo{{{-1, -1, -1}, {1, 1, 1}}, 5000, 24.0});
+  const ObjectId id = s.add_object(mesh, s.add_material({}), glm::scale(glm::mat4(1.0f), glm::vec3(2.0f)),
+                                   OccluderClass::always);
+  EXPECT_EQ(s.object(id).bounds, (Aabb{{-2, -2, -2}, {2, 2, 2}}));
+  EXPECT_EQ(s.object(id).triangles, 5000u);
+  EXPECT_NEAR(s.object_surface_area(id), 96.0, 1e-4);
+  EXPECT_TRUE(s.mesh(mesh).positions.empty());
+  EXPECT_THROW((void)s.add_mesh(MeshInfo{{{0, 0, 0}, {std::nanf(""), 1, 1}}, 1, 1.0}), InputError);
+  EXPECT_THROW((void)s.add_mesh(MeshInfo{{{0, 0, 0}, {1, 1, 1}}, 1, -1.0}), InputError);
+}
+
+TEST(Scene, TheListOfMovedObjectsStaysBoundedAndConsumersStillSeeEverything) {
+  Scene s = test::box_scene({{{0, 0, 0}, {1, 1, 1}}, {{5, 0, 0}, {6, 1, 1}}});
+  const std::uint64_t start = s.placement_revision();
+  for (int k = 0; k < 1000; ++k) s.set_transform(ObjectId(k % 2), glm::translate(glm::mat4(1.0f), {float(k), 0, 0}));
+  EXPECT_LE(s.moved_objects().size(), 64u);
+  std::vector<int> seen(2, 0);
+  (void)s.for_each_changed_since(start, [&](ObjectId id) { ++seen[id]; });
+  EXPECT_GT(seen[0], 0);
+  EXPECT_GT(seen[1], 0);
 }
