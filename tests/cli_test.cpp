@@ -224,6 +224,14 @@ TEST(Cli, RenderShowsTheGridsCellsAndEndsCleanly) {
   EXPECT_NE(r.output.find("cells drawn"), std::string::npos) << r.output;
 }
 
+TEST(Cli, RenderTakesTheAlgorithmSpecsBenchTakes) {
+  CliRun r = run(std::string("render ") + kTinyCity + " --algo chcpp:batch=20 --frame 2 --frames 3 --out /dev/null");
+  EXPECT_EQ(r.code, 0) << r.output;
+  r = run(std::string("render ") + kTinyCity + " --algo oracle --out /dev/null");
+  EXPECT_EQ(r.code, 2) << r.output;
+  EXPECT_NE(r.output.find("ground truth"), std::string::npos) << r.output;
+}
+
 TEST(Cli, RenderRefusesAViewTheAlgorithmHasNot) {
   CliRun r = run(std::string("render ") + kTinyCity + " --algo chc --view cells --out /dev/null");
   EXPECT_EQ(r.code, 2) << r.output;

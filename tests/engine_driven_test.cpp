@@ -7,6 +7,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <random>
 #include <set>
@@ -113,6 +114,15 @@ TEST(EngineDrivenScene, EveryAlgorithmFollowsMovesAdditionsAndRemovals) {
       if (info.conservative)
         for (ObjectId id : truth)
           EXPECT_TRUE(rendered.count(id)) << info.name << " missed object " << id << " in frame " << frame;
+      // The visible set out: what the backend was asked to draw, each once.
+      const auto drawn = culler->drawn_objects();
+      EXPECT_TRUE(std::is_sorted(drawn.begin(), drawn.end()));
+      EXPECT_EQ(std::set<ObjectId>(drawn.begin(), drawn.end()), rendered) << info.name << " frame " << frame;
+      EXPECT_EQ(std::size_t(drawn.size()), rendered.size()) << info.name << " frame " << frame;
+      for (ObjectId id : objects_not_drawn(scene, view, drawn)) {
+        EXPECT_FALSE(rendered.count(id));
+        if (info.conservative) EXPECT_FALSE(truth.count(id)) << info.name << " found visible object " << id << " occluded";
+      }
     }
     culler->release(backend);
     EXPECT_EQ(backend.in_flight(), 0u) << info.name;

@@ -56,6 +56,9 @@ constexpr const char* kMallocHelp =
 constexpr const char* kGlDebugHelp =
     "GL debug contexts: the driver checks every call, and a failing one stops the run with exit 1, "
     "naming the call and its stack (slower: not for timings)";
+constexpr const char* kDepthHelp =
+    "depth convention of the views: standard (OpenGL's [-1, 1]) or reversed (reversed-Z in [0, 1] with an "
+    "infinite far plane, as engines render); the truth and the verifier follow it";
 
 struct Size {
   int width = 1280;
@@ -218,6 +221,7 @@ struct BenchArgs {
   std::string query_raster = "margin";
   float query_margin = occull::gl::RendererOptions{}.query_margin_px;
   std::string draw = "single";
+  std::string depth = "standard";
   int bvh_leaf = occull::BvhOptions{}.max_leaf_objects;
   int repeat = 1;
   std::string verify = "on";
@@ -341,6 +345,7 @@ occull::BenchConfig bench_config(const BenchArgs& a) {
   c.query_raster = parse_query_raster(a.query_raster);
   c.query_margin_px = a.query_margin;
   c.multi_draw = parse_draw_mode(a.draw);
+  c.depth = occull::parse_depth_mode(a.depth);
   c.gl_debug = a.gl_debug;
   c.stall_guard_ms = a.stall_guard;
   c.watchdog_s = a.watchdog;
@@ -499,6 +504,7 @@ struct RenderArgs {
   std::string view = "color";
   std::vector<std::string> opts;
   bool gl_debug = false;
+  std::string depth = "standard";
 };
 
 // "K" or "A-B" (inclusive), each in [0, frames).
@@ -554,6 +560,7 @@ int cmd_render(const RenderArgs& a) {
   copts.debug = a.gl_debug;
   occull::Session session(a.scene, ropts, {}, copts);
   session.set_sampling({a.fps, a.start});
+  session.set_depth(occull::parse_depth_mode(a.depth));
   const auto& path = session.path(a.path);
   if (last >= path.frames_that_fit(session.sampling()))
     throw occull::InputError(fmt::format("--frame {} at --fps {} from --start {} s lies past the end of path {} ({:.1f} s)",
@@ -561,7 +568,12 @@ int cmd_render(const RenderArgs& a) {
   const std::string algo =
       a.algo.empty() ? std::string(occull::vfc_baseline(session.bundle().world != nullptr)) : a.algo;
   check_view_fits(view, algo);
-  auto culler = occull::make_culler(algo, session.index(), options);
+  if (occull::find_algorithm(occull::parse_algorithm_spec(algo).name).harness_only)
+    throw occull::InputError(fmt::format("--algo {} needs each frame's ground truth: bench runs it, render does not",
+                                         algo));
+  // As bench makes them: specs with options (chcpp:batch=20), nohc with the
+  // calibrated profile (calibrated on first use).
+  auto culler = session.make(algo, options);
   std::unique_ptr<occull::gl::Painter> painter;
   if (view != occull::DebugView::color)
     painter = std::make_unique<occull::gl::Painter>(session.bundle().scene, size.width, size.height);
@@ -799,6 +811,7 @@ int main(int argc, char** argv) {
   b->add_option("--draw", bench.draw,
                 "object submission: single (one draw per object) or multi (one multi-draw per material run)")
       ->capture_default_str();
+  b->add_option("--depth", bench.depth, kDepthHelp)->capture_default_str();
 
   SweepArgs sweep;
   sweep.bench.algos = "grid";
@@ -855,6 +868,7 @@ int main(int argc, char** argv) {
   r->add_option("--view", render.view, view_help)->capture_default_str();
   r->add_option("--opt", render.opts, "algorithm option algo.key=value (repeatable)");
   r->add_flag("--gl-debug", render.gl_debug, kGlDebugHelp);
+  r->add_option("--depth", render.depth, kDepthHelp)->capture_default_str();
 
   occull::app::ViewArgs view_args;
   std::string view_size;
@@ -881,6 +895,7 @@ int main(int argc, char** argv) {
                  "record the flight from the start and write it to this path file at the end "
                  "(bench --path file:FILE replays it)");
   vw->add_flag("--no-ui", view_args.no_ui, "no panel over the view");
+  vw->add_option("--depth", view_args.depth, kDepthHelp)->capture_default_str();
 
   SoakArgs soak;
   auto* so = app.add_subcommand("soak",

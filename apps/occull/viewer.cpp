@@ -238,6 +238,7 @@ int run_viewer(const ViewArgs& a) {
   ropts.width = width;
   ropts.height = height;
   Session session(a.scene, ropts);
+  session.set_depth(parse_depth_mode(a.depth));
   if (small_default)
     fmt::print("occull view: {} is a software renderer, so the window is {}x{} (--size WIDTHxHEIGHT for another)\n",
                session.device().renderer, width, height);

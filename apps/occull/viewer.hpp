@@ -20,6 +20,7 @@ struct ViewArgs {
   std::string record;        ///< the flown path is written here (file:PATH for bench)
   bool verify = false;       ///< ground truth every frame, misses in red
   bool no_ui = false;        ///< no ImGui panel (screenshots of the view alone)
+  std::string depth = "standard";  ///< standard or reversed (occull::parse_depth_mode)
 };
 
 /// Runs the viewer; returns the process's exit code. Throws InputError for

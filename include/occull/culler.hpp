@@ -78,11 +78,20 @@ struct CullRegion {
 class Culler {
  public:
   virtual ~Culler() = default;
-  /// Renders the frame's visible objects through `backend`. The caller has
+  /// Renders the frame's visible objects through `backend` (the algorithm's
+  /// cull()) and records what it drew (drawn_objects()). The caller has
   /// started the frame (cleared the targets) and closes it afterwards.
   /// Returns the culler's own counters; timings and backend counters are
   /// left for the caller to fill.
-  virtual FrameStats render_frame(const View& view, Backend& backend) = 0;
+  FrameStats render_frame(const View& view, Backend& backend);
+
+  /// The objects the last render_frame() drew — handed to the backend's
+  /// render() or render_conditional() — each once, ascending: the visible
+  /// set for shadow passes, reflections, LOD and streaming. Every object of
+  /// the frustum it does not hold was found occluded (or, for a culler that
+  /// is not conservative, culled); objects_not_drawn() lists those. Valid
+  /// until the next render_frame().
+  [[nodiscard]] std::span<const ObjectId> drawn_objects() const;
 
   /// Optional feedback: the owner calls it once the frame rendered by the
   /// last render_frame() is complete, with what it measured (frame_ms at
@@ -110,7 +119,41 @@ class Culler {
   /// Queries issued by this culler and not yet read (0 for cullers that read
   /// every query within the frame that issued it).
   [[nodiscard]] virtual std::size_t queries_held() const { return 0; }
+
+ protected:
+  /// The algorithm: renders the frame's visible objects through `backend`.
+  virtual FrameStats cull(const View& view, Backend& backend) = 0;
+
+ private:
+  // Forwards every call to the frame's backend and keeps the ids drawn.
+  class DrawRecorder final : public Backend {
+   public:
+    Backend* inner = nullptr;
+    std::vector<ObjectId> drawn;
+    void render(std::span<const ObjectId> objects) override {
+      drawn.insert(drawn.end(), objects.begin(), objects.end());
+      inner->render(objects);
+    }
+    QueryId issue_query(std::span<const Aabb> boxes) override { return inner->issue_query(boxes); }
+    bool result_available(QueryId q) override { return inner->result_available(q); }
+    std::uint64_t result(QueryId q) override { return inner->result(q); }
+    [[nodiscard]] bool conditional_rendering() const override { return inner->conditional_rendering(); }
+    void render_conditional(std::span<const ObjectId> objects, QueryId q, ConditionalWait wait) override {
+      drawn.insert(drawn.end(), objects.begin(), objects.end());
+      inner->render_conditional(objects, q, wait);
+    }
+    void flush() override { inner->flush(); }
+    [[nodiscard]] BackendStats stats() const override { return inner->stats(); }
+  };
+  mutable DrawRecorder recorder_;  // drawn_objects() sorts its list once asked
+  mutable bool drawn_sorted_ = true;
 };
+
+/// The objects of `scene` in `view`'s frustum that are not in `drawn`
+/// (ascending, as Culler::drawn_objects() gives it): what a culler found
+/// occluded in that frame. Removed objects are never listed.
+[[nodiscard]] std::vector<ObjectId> objects_not_drawn(const Scene& scene, const View& view,
+                                                      std::span<const ObjectId> drawn);
 
 struct OptionInfo {
   std::string key;            ///< without the algorithm prefix

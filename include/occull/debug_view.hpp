@@ -81,6 +81,7 @@ enum class QueryOutcome : std::uint8_t {
 /// ones before and depth-tested within itself, then `lines` over all.
 struct Picture {
   glm::mat4 view_proj{1.0f};
+  ClipSpace clip;  ///< conventions of view_proj (a frame's view may be reversed-Z)
   bool frame_background = true;  ///< the frame as rendered under everything
   glm::vec3 clear = palette::background;
   struct Paint {

@@ -246,6 +246,12 @@ class Session {
 
   /// Where frames lie on paths (default: spread over the whole path).
   void set_sampling(const FrameSampling& sampling) { sampling_ = sampling; }
+  /// How the scene's lens projects from now on (--depth): OpenGL's standard
+  /// depth, or reversed-Z with an infinite far plane. The renderer, the
+  /// ground truth and the verifier follow each view's conventions.
+  /// Throws InputError for reversed depth on a tiled world (its window of
+  /// tiles is sized by a finite far plane).
+  void set_depth(DepthMode depth);
   [[nodiscard]] const FrameSampling& sampling() const noexcept { return sampling_; }
   /// Path time of frame k of `frames` under the session's sampling.
   [[nodiscard]] double frame_time(const CameraPath& path, int k, int frames) const {
@@ -308,6 +314,7 @@ struct BenchConfig {
   gl::QueryRaster query_raster = gl::QueryRaster::margin;  ///< see gl::RendererOptions
   float query_margin_px = gl::RendererOptions{}.query_margin_px;
   bool multi_draw = false;                ///< see gl::RendererOptions::multi_draw
+  DepthMode depth = DepthMode::standard;  ///< the views' depth convention (Session::set_depth)
   BvhOptions bvh;                         ///< how the scene's hierarchy is built
   bool model = false;                     ///< also predict each frame with the NOHC cost model
   bool gl_debug = false;                  ///< GL debug contexts: a failing GL call stops the run (gl::ContextOptions)

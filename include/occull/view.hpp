@@ -3,7 +3,9 @@
 
 #include "occull/geometry.hpp"
 
+#include <cstdint>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace occull {
@@ -34,12 +36,22 @@ struct View {
   float near_radius = 0.0f;
 };
 
+/// How make_view() builds a lens's projection.
+enum class DepthMode : std::uint8_t {
+  standard,  ///< OpenGL's: depth in [-1, 1] from near to far
+  reversed,  ///< reversed-Z: depth in [0, 1] from near (1) to an infinite far plane (0); Lens::far unused
+};
+
 /// Lens of a perspective camera.
 struct Lens {
   float fov_y_degrees = 60.0f;  ///< vertical field of view, in (0, 180)
   float near = 0.1f;            ///< scene units, > 0
   float far = 2000.0f;          ///< scene units, > near
+  DepthMode depth = DepthMode::standard;
 };
+
+/// "standard" or "reversed" (the --depth option). Throws InputError listing both.
+[[nodiscard]] DepthMode parse_depth_mode(std::string_view name);
 
 /// A camera pose. Yaw turns about +Y (0 looks down -Z, positive turns left
 /// towards -X); pitch looks up when positive. Both in radians.
@@ -70,8 +82,9 @@ struct CameraPose {
 [[nodiscard]] View make_view(const glm::mat4& view, const glm::mat4& proj, int width, int height,
                              const ClipSpace& clip = {});
 
-/// The view of `pose` through `lens` on a width x height viewport, with
-/// OpenGL's clip conventions (a symmetric perspective projection).
+/// The view of `pose` through `lens` on a width x height viewport: a
+/// symmetric perspective projection with OpenGL's clip conventions, or, for
+/// DepthMode::reversed, reversed-Z in [0, 1] with an infinite far plane.
 /// Throws InputError, naming the value, for a pose that is not finite, a
 /// |pitch| not below pi/2, a field of view outside (0, 180) degrees, a lens
 /// without 0 < near < far < infinity (a near plane of 0 leaves the depth

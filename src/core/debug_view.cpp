@@ -42,6 +42,7 @@ void box_edges(const Aabb& b, const glm::vec3& color, std::vector<Picture::Line>
 Picture over_frame(const DebugFrame& f) {
   Picture p;
   p.view_proj = f.view.view_proj;
+  p.clip = f.view.clip;
   p.frame_background = true;
   return p;
 }
@@ -95,6 +96,7 @@ Picture multiqueries_picture(const DebugFrame& f) {
 Picture batches_picture(const DebugFrame& f) {
   Picture p;
   p.view_proj = f.view.view_proj;
+  p.clip = f.view.clip;
   p.frame_background = false;
   // Merge draws and queries by event number; a batch ends where the kind
   // changes. A frame starts in the render state (as the renderer counts
@@ -150,8 +152,11 @@ void frustum_lines(const View& view, std::vector<Picture::Line>& out) {
   std::array<glm::vec3, 4> near_c, far_c;
   for (int i = 0; i < 4; ++i) {
     const float x = (i == 1 || i == 2) ? 1.0f : -1.0f, y = i >= 2 ? 1.0f : -1.0f;
-    near_c[std::size_t(i)] = corner(x, y, -1.0f);
-    far_c[std::size_t(i)] = corner(x, y, 1.0f);
+    near_c[std::size_t(i)] = corner(x, y, view.clip.near_depth());
+    // An infinite far plane is drawn 2000 near-plane distances out.
+    far_c[std::size_t(i)] = std::isfinite(view.far)
+                                ? corner(x, y, view.clip.far_depth())
+                                : view.eye + (near_c[std::size_t(i)] - view.eye) * 2000.0f;
   }
   for (std::size_t i = 0; i < 4; ++i) {
     out.push_back({near_c[i], far_c[i], palette::frustum});

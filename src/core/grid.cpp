@@ -206,12 +206,21 @@ struct DFrustum {
   std::array<glm::dvec4, 6> plane;
 };
 
-DFrustum frustum_of(const View& view) {
+// `reach`: a distance from the eye past every cell of the grid, where an
+// infinite far plane is put instead.
+DFrustum frustum_of(const View& view, double reach) {
   DFrustum f;
   const glm::dmat4 inv = glm::inverse(glm::dmat4(view.view_proj));
+  const double z_near = view.clip.near_depth(), z_far = view.clip.far_depth();
+  const bool infinite = !std::isfinite(view.far);
   for (int i = 0; i < 8; ++i) {
-    const glm::dvec4 p = inv * glm::dvec4((i & 1) ? 1.0 : -1.0, (i & 2) ? 1.0 : -1.0, (i & 4) ? 1.0 : -1.0, 1.0);
+    const double x = (i & 1) ? 1.0 : -1.0, y = (i & 2) ? 1.0 : -1.0;
+    const glm::dvec4 p = inv * glm::dvec4(x, y, (i & 4) && !infinite ? z_far : z_near, 1.0);
     f.corner[std::size_t(i)] = glm::dvec3(p) / p.w;
+    if ((i & 4) && infinite) {  // along the corner's ray, out to `reach` along the view axis
+      const glm::dvec3 eye(view.eye);
+      f.corner[std::size_t(i)] = eye + (f.corner[std::size_t(i)] - eye) * (reach / std::max(1e-9, double(view.near)));
+    }
   }
   for (int i = 0; i < 6; ++i) {
     const Plane& p = view.frustum.plane(i);
@@ -285,7 +294,10 @@ struct AxisRange {
 
 std::span<const CellRun> GridTraversal::traverse(const GridGeometry& g, const View& view, Mode mode) {
   runs_.clear();
-  const DFrustum f = frustum_of(view);
+  double reach = 0.0;  // the grid's farthest corner from the eye
+  const Aabb grid_box = g.bounds();
+  for (int i = 0; i < 8; ++i) reach = std::max(reach, double(glm::length(grid_box.corner(i) - view.eye)));
+  const DFrustum f = frustum_of(view, reach + 1.0);
   const glm::dvec3 origin(g.origin), cell(g.cell);
   const double eps = kMargin * std::min({cell.x, cell.y, cell.z});
   const CellCoord eye = g.cell_of(view.eye);

@@ -162,8 +162,10 @@ bool TiledWorld::covers(const View& view) const {
   const glm::dmat4 inv = glm::inverse(glm::dmat4(view.view_proj));
   const double lo_x = double(centre_.x - radius_) * cell_size_, hi_x = double(centre_.x + radius_ + 1) * cell_size_;
   const double lo_z = double(centre_.z - radius_) * cell_size_, hi_z = double(centre_.z + radius_ + 1) * cell_size_;
+  if (!std::isfinite(view.far)) return false;  // an infinite frustum reaches past any window
   for (int corner = 0; corner < 8; ++corner) {
-    const glm::dvec4 p = inv * glm::dvec4(corner & 1 ? 1 : -1, corner & 2 ? 1 : -1, corner & 4 ? 1 : -1, 1);
+    const double depth = corner & 4 ? view.clip.far_depth() : view.clip.near_depth();
+    const glm::dvec4 p = inv * glm::dvec4(corner & 1 ? 1 : -1, corner & 2 ? 1 : -1, depth, 1);
     const double x = p.x / p.w, z = p.z / p.w;
     if (!(x >= lo_x && x <= hi_x && z >= lo_z && z <= hi_z)) return false;
   }

@@ -109,6 +109,14 @@ View make_view(const glm::mat4& view, const glm::mat4& proj, int width, int heig
   return v;
 }
 
+DepthMode parse_depth_mode(std::string_view name) {
+  if (name == "standard") return DepthMode::standard;
+  if (name == "reversed") return DepthMode::reversed;
+  throw InputError(fmt::format("depth mode '{}': must be standard (OpenGL's [-1, 1]) or reversed (reversed-Z in "
+                               "[0, 1], infinite far plane)",
+                               name));
+}
+
 View make_view(const CameraPose& pose, const Lens& lens, int width, int height) {
   limits::check_viewport(width, height, "viewport");
   const glm::vec3& p = pose.position;
@@ -126,14 +134,25 @@ View make_view(const CameraPose& pose, const Lens& lens, int width, int height) 
                                  lens.near, lens.far));
   const float cp = std::cos(pose.pitch);
   const glm::vec3 forward(-std::sin(pose.yaw) * cp, std::sin(pose.pitch), -std::cos(pose.yaw) * cp);
-  View v = make_view(glm::lookAt(pose.position, pose.position + forward, glm::vec3(0, 1, 0)),
-                     glm::perspective(glm::radians(lens.fov_y_degrees), float(width) / float(height), lens.near,
-                                      lens.far),
-                     width, height);
-  // The pose's own numbers, free of the matrices' rounding.
+  const glm::mat4 view = glm::lookAt(pose.position, pose.position + forward, glm::vec3(0, 1, 0));
+  const float aspect = float(width) / float(height);
+  View v;
+  if (lens.depth == DepthMode::reversed) {
+    // Depth = near / distance: 1 at the near plane, 0 at infinity.
+    glm::mat4 proj(0.0f);
+    const float f = 1.0f / std::tan(glm::radians(lens.fov_y_degrees) / 2.0f);
+    proj[0][0] = f / aspect;
+    proj[1][1] = f;
+    proj[2][3] = -1.0f;
+    proj[3][2] = lens.near;
+    v = make_view(view, proj, width, height, {DepthRange::zero_to_one, true});
+  } else {
+    v = make_view(view, glm::perspective(glm::radians(lens.fov_y_degrees), aspect, lens.near, lens.far), width,
+                  height);
+    v.far = lens.far;  // the lens's own number, free of the matrix's rounding
+  }
   v.eye = pose.position;
   v.near = lens.near;
-  v.far = lens.far;
   return v;
 }
 

@@ -103,7 +103,7 @@ class AutoCuller final : public Culler {
   AutoCuller(const SceneIndex& index, std::vector<std::unique_ptr<Culler>> candidates, const AutoConfig& config)
       : index_(index), candidates_(std::move(candidates)), schedule_(config, candidates_.size()) {}
 
-  FrameStats render_frame(const View& view, Backend& backend) override {
+  FrameStats cull(const View& view, Backend& backend) override {
     if (awaiting_feedback_) schedule_.finished(own_ms_ / content_);  // the owner did not call frame_finished
     in_frustum_.clear();
     FrameStats ignored;

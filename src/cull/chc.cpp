@@ -33,7 +33,7 @@ class ChcCuller final : public Culler {
         state_(index.bvh.size()),
         submitter_(std::uint32_t(options.get_int("chc.flush_every", 8, 1, 1 << 20))) {}
 
-  FrameStats render_frame(const View& view, Backend& backend) override {
+  FrameStats cull(const View& view, Backend& backend) override {
     ++frame_;
     seen_.begin(index_.scene);
     if (seen_.rebuilt(index_.bvh)) carry_over(state_, index_.bvh, seen_, frame_ - 1);

@@ -136,7 +136,7 @@ class ChcppCuller final : public Culler {
       : index_(index), config_(config), persistence_(config.pkeep_min_samples),
         state_(index.bvh.size()), random_(config.seed), gate_(reset_nodes(), config.enter_p_min) {}
 
-  FrameStats render_frame(const View& view, Backend& backend) override {
+  FrameStats cull(const View& view, Backend& backend) override {
     ++frame_;
     seen_.begin(index_.scene);
     if (seen_.rebuilt(index_.bvh)) {

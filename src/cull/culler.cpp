@@ -5,6 +5,7 @@
 #include "occull/error.hpp"
 #include "occull/input_limits.hpp"
 
+#include <algorithm>
 #include <cctype>
 #include <charconv>
 #include <cmath>
@@ -302,6 +303,36 @@ bool is_conservative(const AlgorithmSpec& spec) {
     if (it != spec.options.values().end() && it->second != o.default_value) return false;
   }
   return true;
+}
+
+FrameStats Culler::render_frame(const View& view, Backend& backend) {
+  recorder_.inner = &backend;
+  recorder_.drawn.clear();
+  drawn_sorted_ = false;
+  FrameStats stats = cull(view, recorder_);
+  recorder_.inner = nullptr;  // no backend kept between frames
+  return stats;
+}
+
+std::span<const ObjectId> Culler::drawn_objects() const {
+  if (!drawn_sorted_) {
+    std::vector<ObjectId>& d = recorder_.drawn;
+    std::sort(d.begin(), d.end());
+    d.erase(std::unique(d.begin(), d.end()), d.end());
+    drawn_sorted_ = true;
+  }
+  return recorder_.drawn;
+}
+
+std::vector<ObjectId> objects_not_drawn(const Scene& scene, const View& view, std::span<const ObjectId> drawn) {
+  std::vector<ObjectId> out;
+  std::size_t k = 0;
+  for (ObjectId id = 0; id < scene.objects().size(); ++id) {
+    while (k < drawn.size() && drawn[k] < id) ++k;
+    if (k < drawn.size() && drawn[k] == id) continue;
+    if (scene.alive(id) && view.frustum.classify(scene.object(id).bounds) != Containment::outside) out.push_back(id);
+  }
+  return out;
 }
 
 std::unique_ptr<Culler> make_culler(std::string_view name, const SceneIndex& index,

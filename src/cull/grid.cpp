@@ -87,7 +87,7 @@ class GridCuller final : public Culler {
         drawn_(index.scene.objects().size(), ~std::uint64_t(0)),
         seen_placement_(index.scene.placement_revision()), rng_(config.seed) {}
 
-  FrameStats render_frame(const View& view, Backend& backend) override {
+  FrameStats cull(const View& view, Backend& backend) override {
     FrameStats stats;
     for (ObjectId id : scene_.dynamic_objects()) grid_->update(id, scene_.object(id).bounds);
     // What the engine moved, added or removed (the grid may be shared: updates are idempotent).

@@ -102,7 +102,7 @@ class NohcCuller final : public Culler {
     max_parallel_ = config.max_parallel > 0 ? config.max_parallel : std::max(1, hw_.max_parallel_queries());
   }
 
-  FrameStats render_frame(const View& view, Backend& backend) override {
+  FrameStats cull(const View& view, Backend& backend) override {
     ++frame_;
     // A rebuilt hierarchy starts over (conservative: only queries cull); a
     // changed set of objects changes the nodes' areas and shading.

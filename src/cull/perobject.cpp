@@ -32,7 +32,7 @@ class PerObjectCuller final : public Culler {
     for (State& s : state_) s.frames_without_test = interval_;
   }
 
-  FrameStats render_frame(const View& view, Backend& backend) override {
+  FrameStats cull(const View& view, Backend& backend) override {
     FrameStats stats;
     ++frame_;
     if (state_.size() < index_.scene.objects().size()) {  // objects added: unknown, so tested

@@ -18,7 +18,7 @@ class PerTileCuller final : public Culler {
       : world_(tiled_world(index, "pertile")),
         cache_(index, "chcpp", o, o.get_int("pertile.evict", 60, 1, 1000000)) {}
 
-  FrameStats render_frame(const View& view, Backend& backend) override {
+  FrameStats cull(const View& view, Backend& backend) override {
     FrameStats stats;
     cache_.begin_frame(++frame_, stats);
     cells_in_frustum(world_, view, true, cells_);

@@ -14,7 +14,7 @@ class StopWaitCuller final : public Culler {
   StopWaitCuller(const SceneIndex& index, const Options& options)
       : index_(index), common_(read_common_options(options, "stopwait")) {}
 
-  FrameStats render_frame(const View& view, Backend& backend) override {
+  FrameStats cull(const View& view, Backend& backend) override {
     FrameStats stats;
     const Bvh& bvh = index_.bvh;
     const float radius = near_plane_radius(view);

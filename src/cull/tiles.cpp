@@ -45,7 +45,7 @@ class TilesCuller final : public Culler {
         common_box_(o.get_choice("tiles.box", "common", {"common", "tile"}) == "common"),
         requery_(std::uint64_t(o.get_int("tiles.requery", 1, 1, 1000))) {}
 
-  FrameStats render_frame(const View& view, Backend& backend) override {
+  FrameStats cull(const View& view, Backend& backend) override {
     FrameStats stats;
     stats_ = &stats;
     backend_ = &backend;

@@ -17,7 +17,7 @@ class TileVfcCuller final : public Culler {
       : index_(index), world_(tiled_world(index, "tilevfc")),
         cache_(index, "", o, o.get_int("tilevfc.evict", 60, 1, 1000000)) {}
 
-  FrameStats render_frame(const View& view, Backend& backend) override {
+  FrameStats cull(const View& view, Backend& backend) override {
     FrameStats stats;
     cache_.begin_frame(++frame_, stats);
     cells_in_frustum(world_, view, true, cells_);

@@ -14,7 +14,7 @@ class VfcCuller final : public Culler {
  public:
   explicit VfcCuller(const SceneIndex& index) : index_(index) {}
 
-  FrameStats render_frame(const View& view, Backend& backend) override {
+  FrameStats cull(const View& view, Backend& backend) override {
     FrameStats stats;
     queue_.clear();
     collect_in_frustum_front_to_back(index_, view, queue_, stats);

@@ -212,6 +212,14 @@ FrameStats Session::run_frame(Culler& culler, const View& view, double time_s, F
   return s;
 }
 
+void Session::set_depth(DepthMode depth) {
+  if (depth == DepthMode::reversed && bundle_.world)
+    throw InputError(fmt::format("{}: --depth reversed has an infinite far plane, and a tiled world's window of tiles "
+                                 "is sized by the lens's far plane; use --depth standard there",
+                                 scene_spec_));
+  bundle_.lens.depth = depth;
+}
+
 void Session::release(Culler& culler) { culler.release(backend()); }
 
 void Session::check_queries_returned(std::string_view who) const {
@@ -742,6 +750,7 @@ BenchResult run_bench(const BenchConfig& config, const ProgressFn& progress) {
   gl::ContextOptions copts;
   copts.debug = config.gl_debug;
   Session session(config.scene, ropts, config.bvh, copts);
+  session.set_depth(config.depth);
   session.set_fault_hooks(config.hooks);
   session.set_sampling(config.sampling);
   session.set_stall_guard(config.stall_guard_ms);

@@ -122,6 +122,8 @@ std::size_t check_truth_probes(const FrameLabel& where, const Scene& scene, cons
   constexpr double kSnapPixels = 0.1;
   constexpr double kFloatUlps = 4.0;  // of float rounding in the device's clip-space products
   const glm::dmat4 view_proj(view.view_proj);
+  const bool zero_to_one = view.clip.depth == DepthRange::zero_to_one;
+  const double depth_scale = zero_to_one ? 1.0 : 0.5;  // window depth per unit of normalised depth
   // Largest on screen first: their triangles are the likeliest to qualify.
   std::vector<std::pair<double, ObjectId>> candidates;
   for (ObjectId id : drawn) {
@@ -153,12 +155,14 @@ std::size_t check_truth_probes(const FrameLabel& where, const Scene& scene, cons
         // origin), not with the depth: ~2 ulps of each row's terms.
         const glm::dvec4 world = transform * glm::dvec4(m.positions[m.indices[3 * t + std::size_t(k)]], 1.0);
         const glm::dvec4 clip = view_proj * world;
-        usable = clip.w > 0.0 && clip.z > -clip.w && clip.z < clip.w;
+        usable = clip.w > 0.0 && clip.z > (zero_to_one ? 0.0 : -clip.w) && clip.z < clip.w;
         p[k] = {(clip.x / clip.w * 0.5 + 0.5) * w, (clip.y / clip.w * 0.5 + 0.5) * h};
-        z[k] = clip.z / clip.w * 0.5 + 0.5;
+        // Canonical window depth, as read_depth() gives it: 0 nearest, 1 farthest.
+        const double window = zero_to_one ? clip.z / clip.w : clip.z / clip.w * 0.5 + 0.5;
+        z[k] = view.clip.reversed_z ? 1.0 - window : window;
         double terms = 0.0;
         for (int j = 0; j < 4; ++j) terms += (std::abs(view_proj[j][2]) + std::abs(view_proj[j][3])) * std::abs(world[j]);
-        rounding = std::max(rounding, 0.5 * kFloatUlps * 0x1p-24 * terms / clip.w);
+        rounding = std::max(rounding, depth_scale * kFloatUlps * 0x1p-24 * terms / clip.w);
       }
       if (!usable) continue;
       const double area2 = cross2(p[1] - p[0], p[2] - p[0]);  // twice the signed area, CCW > 0

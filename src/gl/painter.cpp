@@ -205,7 +205,10 @@ void Painter::Impl::draw(GLuint framebuffer, const Picture& picture, std::span<c
   glCullFace(GL_BACK);
   glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
   glDepthMask(GL_TRUE);
-  glDepthFunc(GL_LESS);
+  // The picture's clip conventions (a frame's view may be reversed-Z).
+  glClipControl(GL_LOWER_LEFT,
+                picture.clip.depth == DepthRange::zero_to_one ? GL_ZERO_TO_ONE : GL_NEGATIVE_ONE_TO_ONE);
+  glDepthFunc(picture.clip.reversed_z ? GL_GREATER : GL_LESS);
   glLineWidth(1.0f);
   glBindBuffer(GL_PIXEL_UNPACK_BUFFER, 0);
 
@@ -230,7 +233,7 @@ void Painter::Impl::draw(GLuint framebuffer, const Picture& picture, std::span<c
     glClearColor(c.r, c.g, c.b, c.a);
     glClear(GL_COLOR_BUFFER_BIT);
   }
-  glClearDepth(1.0);
+  glClearDepth(picture.clip.reversed_z ? 0.0 : 1.0);
   glClear(GL_DEPTH_BUFFER_BIT);
 
   // Objects, flat colours, both faces (a debug picture shows what is there).

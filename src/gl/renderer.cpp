@@ -259,6 +259,12 @@ struct Renderer::Impl {
   GLenum conservative_cap = 0;                     // GL_CONSERVATIVE_RASTERIZATION_{NV,INTEL} when present
   GLsizei query_vertices = 36;                     // faces only, or faces and silhouette bands
   float query_slope_px = 0.0f;                     // polygon-offset slope factor of query boxes
+  // The clip conventions of the pass's view: depth range, and with reversed-Z
+  // the depth tests, the depth clear and the polygon offset turn around.
+  ClipSpace clip;
+  [[nodiscard]] GLenum depth_less() const { return clip.reversed_z ? GL_GREATER : GL_LESS; }
+  [[nodiscard]] GLenum depth_less_equal() const { return clip.reversed_z ? GL_GEQUAL : GL_LEQUAL; }
+  [[nodiscard]] float depth_far() const { return clip.reversed_z ? 0.0f : 1.0f; }
   GLuint fbo = 0, color_rb = 0, depth_rb = 0, id_rb = 0;
   GLuint timer = 0;
   bool timer_supported = false;
@@ -514,7 +520,7 @@ void Renderer::Impl::establish_frame_state() const {
   glBindFramebuffer(GL_FRAMEBUFFER, fbo);
   glViewport(0, 0, options.width, options.height);
   glDepthRange(0.0, 1.0);
-  glClipControl(GL_LOWER_LEFT, GL_NEGATIVE_ONE_TO_ONE);
+  glClipControl(GL_LOWER_LEFT, clip.depth == DepthRange::zero_to_one ? GL_ZERO_TO_ONE : GL_NEGATIVE_ONE_TO_ONE);
   // Capabilities that would drop or alter fragments, clears or samples.
   for (GLenum cap : {GL_SCISSOR_TEST, GL_STENCIL_TEST, GL_BLEND, GL_RASTERIZER_DISCARD,
                      GL_COLOR_LOGIC_OP, GL_SAMPLE_ALPHA_TO_COVERAGE, GL_SAMPLE_COVERAGE,
@@ -543,7 +549,7 @@ void Renderer::Impl::enter_render_state(BackendStats& stats) {
   glBindVertexArray(scene_vao);
   glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
   glDepthMask(GL_TRUE);
-  glDepthFunc(GL_LESS);
+  glDepthFunc(depth_less());
   glDisable(GL_DEPTH_CLAMP);
   glDisable(GL_POLYGON_OFFSET_FILL);
   // The query pass culls back faces: set culling both ways.
@@ -559,7 +565,7 @@ void Renderer::Impl::enter_query_state(BackendStats& stats) {
   glBindVertexArray(query_vao);
   glColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
   glDepthMask(GL_FALSE);
-  glDepthFunc(GL_LEQUAL);
+  glDepthFunc(depth_less_equal());
   glEnable(GL_DEPTH_CLAMP);
   glEnable(GL_POLYGON_OFFSET_FILL);
   // Toward the eye by 2 depth units, plus the depth change of query_slope_px
@@ -567,7 +573,8 @@ void Renderer::Impl::enter_query_state(BackendStats& stats) {
   // (a decal on the ground) interpolates depth from other vertex positions,
   // which snapping moves by a fraction of a pixel; at grazing angles that
   // fraction is worth more depth than any constant offset.
-  glPolygonOffset(-query_slope_px, -2.0f);
+  const float toward_eye = clip.reversed_z ? 1.0f : -1.0f;
+  glPolygonOffset(toward_eye * query_slope_px, toward_eye * 2.0f);
   glEnable(GL_CULL_FACE);  // front faces cover every visible pixel of a box the eye is outside of
   query_culls_back = true;
   if (conservative_cap) glEnable(conservative_cap);
@@ -684,6 +691,7 @@ Renderer::~Renderer() {
 // Context state, camera and per-frame bookkeeping of a pass over `view`;
 // the targets keep what they hold.
 void Renderer::Impl::prepare_pass(const View& view) {
+  clip = view.clip;
   if (scene.objects().size() > object_capacity)
     throw std::logic_error(fmt::format("gl::Renderer: the scene has {} objects, {} more than when the renderer was "
                                        "made; objects added later need a new renderer (ids removed and reused are fine)",
@@ -716,8 +724,8 @@ void Renderer::begin_frame(const View& view) {
   glClearNamedFramebufferfv(g.fbo, GL_COLOR, 0, glm::value_ptr(bg));
   const GLuint zero[4] = {0, 0, 0, 0};
   if (g.write_ids) glClearNamedFramebufferuiv(g.fbo, GL_COLOR, 1, zero);
-  const float one = 1.0f;
-  glClearNamedFramebufferfv(g.fbo, GL_DEPTH, 0, &one);
+  const float far = g.depth_far();
+  glClearNamedFramebufferfv(g.fbo, GL_DEPTH, 0, &far);
   // Fresh storage for this frame's query boxes (orphaning: the previous
   // frame's draws keep their copy).
   glNamedBufferData(g.box_buffer, kBoxCapacity * GLsizeiptr(sizeof(Aabb)), nullptr, GL_STREAM_DRAW);
@@ -931,7 +939,7 @@ std::span<const std::uint32_t> Renderer::frame_query_sizes() const noexcept {
 }
 
 // Draws `ids` against the depth buffer as it stands, writing nothing, and
-// returns the samples that pass (GL_LESS, as the scene pass). Not counted.
+// returns the samples that pass (the scene pass's depth test). Not counted.
 std::uint64_t Renderer::Impl::samples_passing(std::span<const ObjectId> ids) {
   BackendStats ignored;
   enter_render_state(ignored);
@@ -964,6 +972,8 @@ std::vector<float> Renderer::read_depth() const {
   bind_for_reading(g.fbo, 4);
   glReadPixels(0, 0, g.options.width, g.options.height, GL_DEPTH_COMPONENT, GL_FLOAT, depth.data());
   check_error("reading the depth buffer");
+  if (g.clip.reversed_z)  // canonical: 0 nearest, 1 farthest and nothing
+    for (float& d : depth) d = 1.0f - d;
   return depth;
 }
 

@@ -158,7 +158,7 @@ class Renderer final : public Backend {
   /// The images a measuring pass read back (row-major, bottom row first).
   struct PassImages {
     std::vector<std::uint32_t> ids;  ///< 0 background, else object id + 1
-    std::vector<float> depth;        ///< window depth in [0, 1]; 1 where nothing opaque was drawn
+    std::vector<float> depth;        ///< canonical window depth in [0, 1] (read_depth()); 1 where nothing opaque was drawn
   };
 
   /// Untimed measuring pass (ground truth): draws `objects` for `view` into
@@ -181,7 +181,9 @@ class Renderer final : public Backend {
   [[nodiscard]] std::uint64_t samples_in_front(const View& view, std::span<const ObjectId> objects);
 
   /// The depth target after end_frame(): width*height window depths in
-  /// [0, 1], bottom row first; 1 where no opaque object was drawn.
+  /// [0, 1], bottom row first, canonical whatever the last pass's view's
+  /// clip conventions: 0 nearest, 1 farthest and where no opaque object was
+  /// drawn (with reversed-Z, where the device stores d, this returns 1 - d).
   [[nodiscard]] std::vector<float> read_depth() const;
 
   /// Writing object ids can be switched off (timed runs that do not verify).
