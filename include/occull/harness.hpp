@@ -261,6 +261,11 @@ class Session {
   [[nodiscard]] View view_at(const CameraPath& path, int k, int frames) const;
 
   [[nodiscard]] const SceneBundle& bundle() const noexcept { return bundle_; }
+  /// The scene, for an engine's changes between frames (set_transform,
+  /// remove_object, add_object reusing removed ids): run_frame() refits the
+  /// hierarchy to them. The renderer refuses objects added past the count
+  /// the scene had when it was made.
+  [[nodiscard]] Scene& scene() noexcept { return bundle_.scene; }
   [[nodiscard]] SceneIndex index() const noexcept { return {bundle_.scene, bvh_, bundle_.world.get()}; }
   [[nodiscard]] gl::Renderer& renderer() noexcept { return *renderer_; }
   [[nodiscard]] gl::Context& context() noexcept { return *context_; }

@@ -278,7 +278,7 @@ FrameTruth Session::truth_of(const View& view, const detail::FrameLabel& where) 
   std::vector<std::uint8_t> drawn(objects.size(), 0);
   for (ObjectId id : in_frustum) drawn[id] = 1;
   for (ObjectId id = 0; id < objects.size(); ++id)
-    if (!drawn[id] && !scene.material(objects[id].material).translucent) outside.push_back(id);
+    if (!drawn[id] && scene.alive(id) && !scene.material(objects[id].material).translucent) outside.push_back(id);
   const std::uint64_t outside_samples = renderer_->samples_in_front(view, outside);
 
   context_->check("the ground truth");
