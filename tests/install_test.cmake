@@ -1,5 +1,7 @@
 # Installs occull from BUILD_DIR into a scratch prefix, then configures,
-# builds and runs tests/consumer against it with find_package(occull).
+# builds and runs tests/consumer and the example engine (examples/engine,
+# which implements a Backend and renders frames) against it with
+# find_package(occull).
 set(prefix "${WORK_DIR}/prefix")
 set(consumer_build "${WORK_DIR}/consumer")
 file(REMOVE_RECURSE "${WORK_DIR}")
@@ -26,4 +28,20 @@ endif()
 execute_process(COMMAND "${consumer_build}/consumer" RESULT_VARIABLE rc)
 if(rc)
   message(FATAL_ERROR "the consumer failed: ${rc}")
+endif()
+
+set(engine_build "${WORK_DIR}/engine")
+execute_process(COMMAND "${CMAKE_COMMAND}" -S "${SOURCE_DIR}/examples/engine" -B "${engine_build}"
+                        -G Ninja -DCMAKE_PREFIX_PATH=${prefix} -DCMAKE_BUILD_TYPE=Release ${flags}
+                RESULT_VARIABLE rc)
+if(rc)
+  message(FATAL_ERROR "configuring the example engine with find_package(occull) failed: ${rc}")
+endif()
+execute_process(COMMAND "${CMAKE_COMMAND}" --build "${engine_build}" RESULT_VARIABLE rc)
+if(rc)
+  message(FATAL_ERROR "building the example engine failed: ${rc}")
+endif()
+execute_process(COMMAND "${engine_build}/occull_example_engine" --frames 20 --size 96x54 RESULT_VARIABLE rc)
+if(rc)
+  message(FATAL_ERROR "the example engine failed: ${rc}")
 endif()
