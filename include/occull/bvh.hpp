@@ -127,9 +127,10 @@ class Bvh {
   std::uint64_t seen_placement_ = 0;  // Scene::placement_revision() refit() has followed
   std::uint64_t generation_ = 0;
   double built_sah_ = 0.0;
-  std::vector<NodeId> dirty_;      // refit()'s scratch: nodes to refit
-  std::vector<std::uint8_t> marked_;
+  std::vector<std::uint8_t> marked_;  // refit()'s scratch: nodes to refit
+  double weighted_area_ = 0.0;     // sum over nodes of area x SAH weight, kept by refit()
   void finish_build();             // leaf_of_, built_sah_ of a new tree
+  [[nodiscard]] double sah_of_weighted_area() const;  // sah_cost() from weighted_area_
 };
 
 }  // namespace occull

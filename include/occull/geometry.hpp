@@ -32,7 +32,11 @@ struct Aabb {
   /// Edge lengths. Precondition: !empty().
   [[nodiscard]] glm::vec3 extent() const noexcept { return max - min; }
   /// Total surface area of the six faces; 0 for an empty box.
-  [[nodiscard]] float surface_area() const noexcept;
+  [[nodiscard]] float surface_area() const noexcept {  // inline: the hierarchy's upkeep calls it per node
+    if (empty()) return 0.0f;
+    const glm::vec3 e = extent();
+    return 2.0f * (e.x * e.y + e.y * e.z + e.z * e.x);
+  }
   /// Volume; 0 for an empty box.
   [[nodiscard]] float volume() const noexcept;
 

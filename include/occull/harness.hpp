@@ -252,6 +252,14 @@ class Session {
   /// Throws InputError for reversed depth on a tiled world (its window of
   /// tiles is sized by a finite far plane).
   void set_depth(DepthMode depth);
+  /// Objects moved by the engine, for benchmarks (--engine-moves): from now
+  /// on, before every frame and its truth, `fraction` of the static objects
+  /// (every round(1 / fraction)-th; 0: none) are moved with
+  /// Scene::set_transform, not a Motion, around small circles (2 scene units
+  /// across, one turn in 4 s of path time) about where they stood, as an
+  /// engine's game logic would; the hierarchy follows in run_frame().
+  /// Throws InputError for a fraction outside [0, 1] or on a tiled world.
+  void set_engine_moves(double fraction);
   [[nodiscard]] const FrameSampling& sampling() const noexcept { return sampling_; }
   /// Path time of frame k of `frames` under the session's sampling.
   [[nodiscard]] double frame_time(const CameraPath& path, int k, int frames) const {
@@ -280,6 +288,10 @@ class Session {
   double bvh_build_ms_ = 0.0;
   std::string scene_spec_;
   SceneBundle bundle_;
+  std::vector<ObjectId> engine_moved_;      // set_engine_moves: the objects moved
+  std::vector<glm::mat4> engine_home_;      // ... and where they stood
+  // The scene at path time `time_s`: Motions, then the engine's moves.
+  void advance_scene(double time_s);
   Bvh bvh_;
   std::unique_ptr<gl::Context> context_;
   gl::DeviceInfo device_;
@@ -320,6 +332,7 @@ struct BenchConfig {
   float query_margin_px = gl::RendererOptions{}.query_margin_px;
   bool multi_draw = false;                ///< see gl::RendererOptions::multi_draw
   DepthMode depth = DepthMode::standard;  ///< the views' depth convention (Session::set_depth)
+  double engine_moves = 0.0;              ///< fraction of static objects the engine moves each frame (Session::set_engine_moves)
   BvhOptions bvh;                         ///< how the scene's hierarchy is built
   bool model = false;                     ///< also predict each frame with the NOHC cost model
   bool gl_debug = false;                  ///< GL debug contexts: a failing GL call stops the run (gl::ContextOptions)
@@ -425,6 +438,9 @@ struct BenchResult {
   int height = 0;
   std::string query_geometry;                ///< how query boxes were kept conservative (describe_query_raster)
   std::string allocator;                     ///< BenchConfig::allocator ("" when not given)
+  /// Run conditions beyond the defaults, for a person: reversed depth,
+  /// engine moves ("" when none).
+  std::string conditions;
   std::vector<AlgorithmRun> runs;            ///< in execution order
   std::vector<AlgorithmSummary> summaries;   ///< one per algorithm, in the order asked
 };

@@ -186,6 +186,7 @@ void Bvh::finish_build() {
       for (ObjectId id : objects(n))
         if (id < leaf_of_.size()) leaf_of_[id] = n;
   built_sah_ = sah_cost(options_.traversal_cost);
+  weighted_area_ = built_sah_ * (nodes_.empty() ? 0.0 : std::max(double(nodes_[0].bounds.surface_area()), 1e-12));
   marked_.assign(nodes_.size(), 0);
 }
 
@@ -227,8 +228,12 @@ void Bvh::refit(const Scene& scene) {
     return;
   }
   const auto objects = scene.objects();
+  // Refits node n from its objects or children, keeping weighted_area_ (the
+  // SAH cost times the root's area) up to date as it goes.
   const auto refit_node = [&](NodeId n) {
     BvhNode& node = nodes_[n];
+    const double weight = node.is_leaf() ? double(node.object_count) : double(options_.traversal_cost);
+    weighted_area_ -= weight * double(node.bounds.surface_area());
     if (node.is_leaf()) {
       node.bounds = Aabb{};
       node.triangles = 0;
@@ -241,10 +246,12 @@ void Bvh::refit(const Scene& scene) {
       node.bounds.extend(nodes_[node.right].bounds);
       node.triangles = nodes_[left(n)].triangles + nodes_[node.right].triangles;
     }
+    weighted_area_ += weight * double(node.bounds.surface_area());
   };
   // The dynamic subtree: its objects move every frame (Scene::update).
   // Children follow their parents in the array, so a reverse sweep sees
   // every child before its parent.
+  const NodeId static_end = dynamic_root_ != kNoNode ? dynamic_root_ : NodeId(nodes_.size());
   bool root_stale = false;
   if (dynamic_root_ != kNoNode) {
     for (NodeId n = NodeId(nodes_.size()); n-- > dynamic_root_;) refit_node(n);
@@ -252,31 +259,34 @@ void Bvh::refit(const Scene& scene) {
   } else if (!scene.dynamic_objects().empty()) {  // one tree for all
     for (NodeId n = NodeId(nodes_.size()); n-- > 0;) refit_node(n);
   }
-  // What the engine changed: each object's leaf and its ancestors.
-  dirty_.clear();
+  // What the engine changed: each object's leaf and its ancestors, marked,
+  // then refitted children first by a sweep down the marked range.
+  NodeId lowest = static_end, highest = 0;
   seen_placement_ = scene.for_each_changed_since(seen_placement_, [&](ObjectId id) {
     for (NodeId n = leaf_of_[id]; n != kNoNode && !marked_[n]; n = nodes_[n].parent) {
       marked_[n] = 1;
-      dirty_.push_back(n);
+      lowest = std::min(lowest, n);
+      highest = std::max(highest, n);
     }
   });
-  if (dirty_.empty()) {
-    if (root_stale) refit_node(root());
-    return;
-  }
-  std::sort(dirty_.begin(), dirty_.end(), std::greater<>());  // children before parents
-  for (NodeId n : dirty_) {
-    marked_[n] = 0;
-    if (n >= (dynamic_root_ != kNoNode ? dynamic_root_ : NodeId(nodes_.size()))) continue;  // refit above
-    refit_node(n);
-  }
+  const bool changed = lowest <= highest;
+  if (changed)
+    for (NodeId n = highest + 1; n-- > lowest;) {
+      if (!marked_[n]) continue;
+      marked_[n] = 0;
+      if (n < static_end) refit_node(n);  // the dynamic subtree was refitted above
+    }
   if (root_stale) refit_node(root());
   // Boxes that moved far loosen the tree: rebuild when it got too costly.
-  if (sah_cost(options_.traversal_cost) > kRebuildFactor * built_sah_) {
+  if (changed && sah_of_weighted_area() > kRebuildFactor * built_sah_) {
     const std::uint64_t generation = generation_;
     *this = build(scene, options_);
     generation_ = generation + 1;
   }
+}
+
+double Bvh::sah_of_weighted_area() const {
+  return nodes_.empty() ? 0.0 : weighted_area_ / std::max(double(nodes_[0].bounds.surface_area()), 1e-12);
 }
 
 void Bvh::gather_tight_boxes(NodeId n, int d_max, float s_max, const Scene& scene,

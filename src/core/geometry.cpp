@@ -6,12 +6,6 @@
 
 namespace occull {
 
-float Aabb::surface_area() const noexcept {
-  if (empty()) return 0.0f;
-  const glm::vec3 e = extent();
-  return 2.0f * (e.x * e.y + e.y * e.z + e.z * e.x);
-}
-
 float Aabb::volume() const noexcept {
   if (empty()) return 0.0f;
   const glm::vec3 e = extent();

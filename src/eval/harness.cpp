@@ -13,6 +13,7 @@
 #include "oracle.hpp"
 
 #include <fmt/format.h>
+#include <glm/gtc/matrix_transform.hpp>
 
 #include <algorithm>
 #include <chrono>
@@ -168,7 +169,7 @@ View Session::view_at(const CameraPath& path, int k, int frames) const {
 
 FrameStats Session::run_frame(Culler& culler, const View& view, double time_s, FrameLog* log) {
   const auto step = watchdog_->step(fmt::format("a culler's frame at {:.3f} s of the path", time_s));
-  bundle_.scene.update(time_s);
+  advance_scene(time_s);
   if (bundle_.world) bundle_.world->follow(bundle_.scene, view.eye);
   const ProcessUsage u0 = process_usage();
   const auto t0 = Clock::now();
@@ -220,6 +221,34 @@ void Session::set_depth(DepthMode depth) {
   bundle_.lens.depth = depth;
 }
 
+void Session::set_engine_moves(double fraction) {
+  if (!(fraction >= 0.0 && fraction <= 1.0))
+    throw InputError(fmt::format("engine moves {}: must be a fraction of the objects in [0, 1]", fraction));
+  if (bundle_.world && fraction > 0.0)
+    throw InputError(fmt::format("{}: a tiled world places its own objects; engine moves are for other scenes",
+                                 scene_spec_));
+  for (std::size_t i = 0; i < engine_moved_.size(); ++i)  // back where they stood
+    bundle_.scene.set_transform(engine_moved_[i], engine_home_[i]);
+  engine_moved_.clear();
+  engine_home_.clear();
+  if (fraction <= 0.0) return;
+  const auto every = std::max<ObjectId>(1, ObjectId(std::lround(1.0 / fraction)));
+  for (ObjectId id = 0; id < bundle_.scene.objects().size(); id += every)
+    if (bundle_.scene.alive(id) && !bundle_.scene.object(id).dynamic()) {
+      engine_moved_.push_back(id);
+      engine_home_.push_back(bundle_.scene.object(id).transform);
+    }
+}
+
+void Session::advance_scene(double time_s) {
+  bundle_.scene.update(time_s);
+  for (std::size_t i = 0; i < engine_moved_.size(); ++i) {
+    const double angle = time_s * (2.0 * 3.14159265358979 / 4.0) + 0.7 * double(i);
+    const glm::vec3 offset(float(std::cos(angle)), 0.0f, float(std::sin(angle)));
+    bundle_.scene.set_transform(engine_moved_[i], glm::translate(glm::mat4(1.0f), offset) * engine_home_[i]);
+  }
+}
+
 void Session::release(Culler& culler) { culler.release(backend()); }
 
 void Session::check_queries_returned(std::string_view who) const {
@@ -244,7 +273,7 @@ std::vector<FrameTruth> Session::ground_truth(const CameraPath& path, int frames
 }
 
 FrameTruth Session::truth_at(const CameraPath& path, int k, int frames) {
-  bundle_.scene.update(frame_time(path, k, frames));
+  advance_scene(frame_time(path, k, frames));
   const View view = view_at(path, k, frames);
   const detail::FrameLabel where{scene_spec_, path.name(), k};
   if (bundle_.world) {
@@ -751,6 +780,7 @@ BenchResult run_bench(const BenchConfig& config, const ProgressFn& progress) {
   copts.debug = config.gl_debug;
   Session session(config.scene, ropts, config.bvh, copts);
   session.set_depth(config.depth);
+  session.set_engine_moves(config.engine_moves);
   session.set_fault_hooks(config.hooks);
   session.set_sampling(config.sampling);
   session.set_stall_guard(config.stall_guard_ms);
@@ -832,6 +862,13 @@ BenchResult run_bench(const BenchConfig& config, const ProgressFn& progress) {
   result.height = config.height;
   result.query_geometry = gl::describe_query_raster(ropts);
   result.allocator = config.allocator;
+  if (config.depth == DepthMode::reversed)
+    result.conditions += "views: reversed-Z, depth in [0, 1], an infinite far plane (--depth reversed)";
+  if (config.engine_moves > 0.0)
+    result.conditions += fmt::format("{}engine moves: {:.0f}% of the static objects moved by set_transform every "
+                                     "frame (--engine-moves {})",
+                                     result.conditions.empty() ? "" : "; ", 100.0 * config.engine_moves,
+                                     config.engine_moves);
 
   std::vector<std::vector<FrameTruth>> truths(paths.size());
   if (config.verify)

@@ -116,6 +116,7 @@ void print_table(const BenchResult& r, std::ostream& out) {
   out << fmt::format("device: {} | {} | occull {}\nquery boxes: {}\n", r.device.renderer, r.device.version,
                      r.commit, r.query_geometry);
   if (!r.allocator.empty()) out << fmt::format("allocator: {}\n", r.allocator);
+  if (!r.conditions.empty()) out << fmt::format("conditions: {}\n", r.conditions);
   out << "\n";
   std::size_t w = 10;
   for (const AlgorithmSummary& a : r.summaries) w = std::max(w, a.name.size());
@@ -232,6 +233,7 @@ nlohmann::ordered_json detail::bench_json(const BenchResult& r) {
   doc["size"] = {r.width, r.height};
   doc["query_geometry"] = r.query_geometry;
   doc["allocator"] = r.allocator;
+  doc["conditions"] = r.conditions;
   ordered_json algos = ordered_json::array();
   for (const AlgorithmSummary& a : r.summaries) {
     algos.push_back({{"name", a.name},
@@ -381,6 +383,7 @@ std::vector<std::string> write_report(const BenchResult& r, const std::string& d
   md += fmt::format("- {}\n", verification_text(r));
   md += fmt::format("- query boxes: {}\n", r.query_geometry);
   if (!r.allocator.empty()) md += fmt::format("- allocator: {}\n", r.allocator);
+  if (!r.conditions.empty()) md += fmt::format("- conditions: {}\n", r.conditions);
   md += fmt::format("- occull commit: `{}`\n\n## Results\n\n", r.commit);
   md += "| algorithm | mean ms | median | p95 | max | vs vfc | vs oracle | queries | state changes | "
         "draws | triangles | missed | frames w/ miss | wrong px | longest miss | extra objects | "
