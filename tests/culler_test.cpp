@@ -1,3 +1,4 @@
+#include "occull/cost_model.hpp"
 #include "occull/culler.hpp"
 #include "occull/error.hpp"
 #include "test_util.hpp"
@@ -118,4 +119,31 @@ TEST(Registry, AThresholdAboveZeroMakesARunApproximate) {
   base.set("chcpp.threshold=2");  // --opt chcpp.threshold=2 reaches every chcpp spec
   EXPECT_FALSE(is_conservative(parse_algorithm_spec("chcpp:batch=10", base)));
   EXPECT_TRUE(is_conservative(parse_algorithm_spec("nohc", base)));
+}
+
+TEST(MakeCuller, TakesSpecsWithOptionsAndAProfileInMemory) {
+  const Scene scene = test::box_scene({{{-1, -1, -10}, {1, 1, -8}}});
+  const Bvh bvh = Bvh::build(scene);
+  EXPECT_NO_THROW((void)make_culler("chcpp:batch=20:tight=off", {scene, bvh}));
+  EXPECT_THROW((void)make_culler("chcpp:nope=1", {scene, bvh}), InputError);
+  EXPECT_THROW((void)make_culler("nohc", {scene, bvh}), InputError);  // no profile anywhere
+  HardwareProfile profile;
+  profile.renderer = "test";
+  profile.width = 64;
+  profile.height = 64;
+  profile.draw_setup_ms = 0.01;
+  profile.triangle_ms = 1e-5;
+  profile.fragment_ms = {{0, 1e-6}};
+  profile.query_setup_ms = 0.02;
+  profile.query_latency_ms = 0.2;
+  profile.query_overhead_ms = 0.005;
+  CullerContext context;
+  context.nohc_profile = &profile;
+  auto nohc = make_culler("nohc:learn=off", {scene, bvh}, {}, context);
+  test::RecordingBackend backend;
+  const View view = make_view({{0, 0, 0}, 0, 0}, {60.0f, 0.1f, 100.0f}, 64, 64);
+  (void)nohc->render_frame(view, backend);
+  EXPECT_EQ(nohc->drawn_objects().size(), 1u);
+  auto with_nohc = make_culler("auto:candidates=vfc+nohc", {scene, bvh}, {}, context);
+  EXPECT_NE(with_nohc, nullptr);
 }

@@ -269,7 +269,7 @@ int run_viewer(const ViewArgs& a) {
     const std::string typed = c.options.data();
     std::string spec_text = typed.empty() ? name : name + ":" + typed;
     std::replace(spec_text.begin(), spec_text.end(), ',', ':');
-    return make_culler(name, session.index(), parse_algorithm_spec(spec_text).options);
+    return session.make(spec_text, {});  // as bench makes them (nohc with the calibrated profile)
   };
   std::unique_ptr<Culler> culler = make();
   std::unique_ptr<Culler> next_culler;  // chosen in the panel; replaces `culler` in occull's context

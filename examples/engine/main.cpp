@@ -389,8 +389,7 @@ int run(const Args& args) {
 
   // [readme: frame]
   occull::Bvh bvh = occull::Bvh::build(scene);
-  const occull::AlgorithmSpec spec = occull::parse_algorithm_spec(args.algo);  // "chcpp" by default
-  auto culler = occull::make_culler(spec.name, {scene, bvh}, spec.options);
+  auto culler = occull::make_culler(args.algo, {scene, bvh});  // "chcpp" (or "chcpp:batch=20", ...)
   EngineBackend backend(objects, meshes);
   // [readme end]
 

@@ -18,6 +18,8 @@
 
 namespace occull {
 
+struct HardwareProfile;
+
 /// What a culler reads: the scene and its hierarchy, shared read-only by
 /// every culler instance. Both must outlive the cullers made from them; the
 /// owner updates the scene and refits the BVH between frames.
@@ -221,11 +223,21 @@ struct AlgorithmSpec {
 /// option. Throws InputError listing the valid algorithms or options.
 void check_options(const Options& options);
 
-/// Makes the named culler. Throws InputError for an unknown name (listing
-/// the valid ones), an unknown / invalid option of that algorithm, or a
-/// scene of a kind it does not run on (AlgorithmInfo::scenes; the message
-/// lists those that do).
-[[nodiscard]] std::unique_ptr<Culler> make_culler(std::string_view name, const SceneIndex& index,
-                                                  const Options& options = {});
+/// What an algorithm may need beyond its options, from the program that
+/// makes it. Pointers are borrowed: they must outlive make_culler() only.
+struct CullerContext {
+  /// nohc's calibrated hardware cost model (occull/cost_model.hpp) in
+  /// memory; without it nohc reads the file its option nohc.profile names.
+  const HardwareProfile* nohc_profile = nullptr;
+};
+
+/// Makes a culler from an algorithm spec: a name ("chcpp") or a name with
+/// options ("chcpp:batch=20:tight=off", see parse_algorithm_spec), over
+/// `options` ("algo.key" -> value) as its base. Throws InputError for an
+/// unknown name (listing the valid ones), an unknown / invalid option of that
+/// algorithm, a scene of a kind it does not run on (AlgorithmInfo::scenes;
+/// the message lists those that do), or nohc without a profile.
+[[nodiscard]] std::unique_ptr<Culler> make_culler(std::string_view spec, const SceneIndex& index,
+                                                  const Options& options = {}, const CullerContext& context = {});
 
 }  // namespace occull

@@ -148,7 +148,7 @@ class AutoCuller final : public Culler {
 
 }  // namespace
 
-std::unique_ptr<Culler> make_auto(const SceneIndex& index, const Options& o) {
+std::unique_ptr<Culler> make_auto(const SceneIndex& index, const Options& o, const CullerContext& context) {
   AutoConfig c;
   c.trial = o.get_int("auto.trial", c.trial, 1, 1000);
   c.period = o.get_int("auto.period", c.period, 1, 1000000);
@@ -162,7 +162,7 @@ std::unique_ptr<Culler> make_auto(const SceneIndex& index, const Options& o) {
       c.candidates.emplace_back(rest.substr(0, plus));
       rest = plus == std::string_view::npos ? std::string_view{} : rest.substr(plus + 1);
     }
-  } else if (!o.has("nohc.profile")) {
+  } else if (!o.has("nohc.profile") && !context.nohc_profile) {
     // nohc needs a calibrated profile; without one (occull bench passes it)
     // the default candidates are chcpp and vfc.
     c.candidates = {"chcpp", "vfc"};
@@ -172,7 +172,7 @@ std::unique_ptr<Culler> make_auto(const SceneIndex& index, const Options& o) {
   for (const std::string& name : c.candidates) {
     if (name == "auto" || name == "oracle")
       throw InputError(fmt::format("option auto.candidates: '{}' cannot be a candidate", name));
-    cullers.push_back(make_culler(name, index, o));
+    cullers.push_back(make_culler(name, index, o, context));
   }
   return std::make_unique<AutoCuller>(index, std::move(cullers), c);
 }

@@ -135,7 +135,7 @@ class ChcCuller final : public Culler {
 
 }  // namespace
 
-std::unique_ptr<Culler> make_chc(const SceneIndex& index, const Options& options) {
+std::unique_ptr<Culler> make_chc(const SceneIndex& index, const Options& options, const CullerContext&) {
   return std::make_unique<ChcCuller>(index, options);
 }
 

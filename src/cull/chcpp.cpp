@@ -427,7 +427,7 @@ class ChcppCuller final : public Culler {
 
 }  // namespace
 
-std::unique_ptr<Culler> make_chcpp(const SceneIndex& index, const Options& options) {
+std::unique_ptr<Culler> make_chcpp(const SceneIndex& index, const Options& options, const CullerContext&) {
   return std::make_unique<ChcppCuller>(index, read_config(options));
 }
 

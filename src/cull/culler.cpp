@@ -14,7 +14,7 @@
 namespace occull {
 namespace {
 
-using Factory = std::unique_ptr<Culler> (*)(const SceneIndex&, const Options&);
+using Factory = std::unique_ptr<Culler> (*)(const SceneIndex&, const Options&, const CullerContext&);
 
 struct Entry {
   AlgorithmInfo info;
@@ -335,10 +335,11 @@ std::vector<ObjectId> objects_not_drawn(const Scene& scene, const View& view, st
   return out;
 }
 
-std::unique_ptr<Culler> make_culler(std::string_view name, const SceneIndex& index,
-                                    const Options& options) {
-  (void)find_algorithm(name);
-  const Entry* entry = find(name);
+std::unique_ptr<Culler> make_culler(std::string_view spec_text, const SceneIndex& index, const Options& base,
+                                    const CullerContext& context) {
+  const AlgorithmSpec spec = parse_algorithm_spec(spec_text, base);
+  const Options& options = spec.options;
+  const Entry* entry = find(spec.name);
   const std::string prefix = entry->info.name + ".";
   for (const auto& [key, value] : options.values())
     if (key.rfind(prefix, 0) == 0) check_option(*entry, key, key.substr(prefix.size()));
@@ -355,7 +356,7 @@ std::unique_ptr<Culler> make_culler(std::string_view name, const SceneIndex& ind
                                  tiled ? "a tiled world (it has no global BVH)" : "a scene that is not a tiled world",
                                  fits));
   }
-  return entry->make(index, options);
+  return entry->make(index, options, context);
 }
 
 }  // namespace occull

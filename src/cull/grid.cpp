@@ -318,7 +318,7 @@ GridConfig grid_config(const Options& o) {
 
 }  // namespace
 
-std::unique_ptr<Culler> make_grid(const SceneIndex& index, const Options& o) {
+std::unique_ptr<Culler> make_grid(const SceneIndex& index, const Options& o, const CullerContext&) {
   const GridConfig c = grid_config(o);
   return std::make_unique<GridCuller>(index, c, std::make_shared<UniformGrid>(UniformGrid::of_scene(index.scene, c.cell)));
 }

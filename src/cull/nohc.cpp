@@ -369,7 +369,7 @@ class NohcCuller final : public Culler {
 
 }  // namespace
 
-std::unique_ptr<Culler> make_nohc(const SceneIndex& index, const Options& o) {
+std::unique_ptr<Culler> make_nohc(const SceneIndex& index, const Options& o, const CullerContext& context) {
   NohcConfig c;
   c.threshold = std::uint64_t(o.get_int("nohc.threshold", 0, 0, 1 << 24));
   c.fragments_per_pixel = o.get_double("nohc.fragments_per_pixel", c.fragments_per_pixel, 0.0, 100.0);
@@ -380,10 +380,11 @@ std::unique_ptr<Culler> make_nohc(const SceneIndex& index, const Options& o) {
   c.virtual_leaf = std::uint32_t(o.get_int("nohc.virtual_leaf", 0, 0, 1 << 30));
   c.flush_every = std::uint32_t(o.get_int("nohc.flush_every", int(c.flush_every), 1, 1 << 20));
   c.learn = o.get_bool("nohc.learn", c.learn);
+  if (context.nohc_profile) return std::make_unique<NohcCuller>(index, c, *context.nohc_profile);
   const auto it = o.values().find("nohc.profile");
   if (it == o.values().end() || it->second.empty())
     throw InputError("nohc needs a hardware profile: run `occull calibrate` (occull bench does it "
-                     "for you), or pass --opt nohc.profile=FILE");
+                     "for you), or pass --opt nohc.profile=FILE (CullerContext::nohc_profile in a program)");
   std::optional<HardwareProfile> profile = load_profile(it->second);
   if (!profile) throw InputError(fmt::format("nohc.profile: '{}' does not exist", it->second));
   return std::make_unique<NohcCuller>(index, c, std::move(*profile));

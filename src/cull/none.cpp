@@ -29,7 +29,7 @@ class NoneCuller final : public Culler {
 
 }  // namespace
 
-std::unique_ptr<Culler> make_none(const SceneIndex& index, const Options&) {
+std::unique_ptr<Culler> make_none(const SceneIndex& index, const Options&, const CullerContext&) {
   return std::make_unique<NoneCuller>(index);
 }
 

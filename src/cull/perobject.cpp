@@ -136,7 +136,7 @@ class PerObjectCuller final : public Culler {
 
 }  // namespace
 
-std::unique_ptr<Culler> make_perobject(const SceneIndex& index, const Options& options) {
+std::unique_ptr<Culler> make_perobject(const SceneIndex& index, const Options& options, const CullerContext&) {
   return std::make_unique<PerObjectCuller>(index, options);
 }
 

@@ -37,7 +37,7 @@ class PerTileCuller final : public Culler {
 
 }  // namespace
 
-std::unique_ptr<Culler> make_pertile(const SceneIndex& index, const Options& options) {
+std::unique_ptr<Culler> make_pertile(const SceneIndex& index, const Options& options, const CullerContext&) {
   return std::make_unique<PerTileCuller>(index, options);
 }
 

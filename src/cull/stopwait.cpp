@@ -54,7 +54,7 @@ class StopWaitCuller final : public Culler {
 
 }  // namespace
 
-std::unique_ptr<Culler> make_stopwait(const SceneIndex& index, const Options& options) {
+std::unique_ptr<Culler> make_stopwait(const SceneIndex& index, const Options& options, const CullerContext&) {
   return std::make_unique<StopWaitCuller>(index, options);
 }
 

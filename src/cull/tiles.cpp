@@ -192,7 +192,7 @@ class TilesCuller final : public Culler {
 
 }  // namespace
 
-std::unique_ptr<Culler> make_tiles(const SceneIndex& index, const Options& options) {
+std::unique_ptr<Culler> make_tiles(const SceneIndex& index, const Options& options, const CullerContext&) {
   return std::make_unique<TilesCuller>(index, options);
 }
 

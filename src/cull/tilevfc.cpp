@@ -45,7 +45,7 @@ class TileVfcCuller final : public Culler {
 
 }  // namespace
 
-std::unique_ptr<Culler> make_tilevfc(const SceneIndex& index, const Options& options) {
+std::unique_ptr<Culler> make_tilevfc(const SceneIndex& index, const Options& options, const CullerContext&) {
   return std::make_unique<TileVfcCuller>(index, options);
 }
 

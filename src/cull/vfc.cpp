@@ -29,7 +29,7 @@ class VfcCuller final : public Culler {
 
 }  // namespace
 
-std::unique_ptr<Culler> make_vfc(const SceneIndex& index, const Options&) {
+std::unique_ptr<Culler> make_vfc(const SceneIndex& index, const Options&, const CullerContext&) {
   return std::make_unique<VfcCuller>(index);
 }
 

@@ -322,13 +322,11 @@ FrameTruth Session::truth_of(const View& view, const detail::FrameLabel& where) 
 }
 
 std::unique_ptr<Culler> Session::make(std::string_view spec, const Options& options) {
-  AlgorithmSpec a = parse_algorithm_spec(spec, options);
+  const AlgorithmSpec a = parse_algorithm_spec(spec, options);
   if (a.name == "oracle") return std::make_unique<detail::OracleCuller>(bundle_.scene);
-  if (needs_profile(a) && !a.options.has("nohc.profile")) {
-    (void)hardware_profile();
-    a.options.set("nohc.profile", hardware_profile_path());
-  }
-  return make_culler(a.name, index(), a.options);
+  CullerContext context;  // nohc: the calibrated profile, unless an option names a file
+  if (needs_profile(a) && !a.options.has("nohc.profile")) context.nohc_profile = &hardware_profile();
+  return make_culler(a.name, index(), a.options, context);
 }
 
 std::string Session::renderer_key() const { return device_.renderer + " | " + device_.version; }
