@@ -127,16 +127,7 @@ TEST(MakeCuller, TakesSpecsWithOptionsAndAProfileInMemory) {
   EXPECT_NO_THROW((void)make_culler("chcpp:batch=20:tight=off", {scene, bvh}));
   EXPECT_THROW((void)make_culler("chcpp:nope=1", {scene, bvh}), InputError);
   EXPECT_THROW((void)make_culler("nohc", {scene, bvh}), InputError);  // no profile anywhere
-  HardwareProfile profile;
-  profile.renderer = "test";
-  profile.width = 64;
-  profile.height = 64;
-  profile.draw_setup_ms = 0.01;
-  profile.triangle_ms = 1e-5;
-  profile.fragment_ms = {{0, 1e-6}};
-  profile.query_setup_ms = 0.02;
-  profile.query_latency_ms = 0.2;
-  profile.query_overhead_ms = 0.005;
+  const HardwareProfile profile = test::hardware_profile();
   CullerContext context;
   context.nohc_profile = &profile;
   auto nohc = make_culler("nohc:learn=off", {scene, bvh}, {}, context);

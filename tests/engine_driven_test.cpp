@@ -28,28 +28,10 @@ std::vector<Aabb> scattered_boxes(int n) {
   return boxes;
 }
 
-std::string write_test_profile() {
-  HardwareProfile p;
-  p.renderer = "test";
-  p.width = 64;
-  p.height = 64;
-  p.draw_setup_ms = 0.01;
-  p.triangle_ms = 1e-5;
-  p.fragment_ms = {{0, 1e-6}, {10, 11e-6}};
-  p.query_setup_ms = 0.02;
-  p.query_fragment_ms = 1e-7;
-  p.query_latency_ms = 0.2;
-  p.query_overhead_ms = 0.005;
-  const std::string file =
-      (std::filesystem::temp_directory_path() / ("occull-engine-" + std::to_string(::getpid()) + ".json")).string();
-  save_profile(p, file);
-  return file;
-}
-
 }  // namespace
 
 TEST(EngineDrivenScene, EveryAlgorithmFollowsMovesAdditionsAndRemovals) {
-  const std::string profile = write_test_profile();
+  const test::ProfileFile profile("occull-engine-" + std::to_string(::getpid()) + ".json");
   const View view = make_view({{0, 0, 0}, 0, 0}, {70.0f, 0.1f, 500.0f}, 64, 64);
   std::size_t rebuilds = 0, removed_seen = 0;
   for (const AlgorithmInfo& info : algorithms()) {
@@ -57,7 +39,7 @@ TEST(EngineDrivenScene, EveryAlgorithmFollowsMovesAdditionsAndRemovals) {
     Scene scene = test::box_scene(scattered_boxes(120));
     Bvh bvh = Bvh::build(scene);
     Options options;
-    if (info.name == "nohc" || info.name == "auto") options.set("nohc.profile", profile);
+    if (info.name == "nohc" || info.name == "auto") options.set("nohc.profile", profile.path());
     auto culler = make_culler(info.name, {scene, bvh}, options);
     test::RecordingBackend backend;
     std::vector<Aabb> visible;
@@ -127,7 +109,6 @@ TEST(EngineDrivenScene, EveryAlgorithmFollowsMovesAdditionsAndRemovals) {
     culler->release(backend);
     EXPECT_EQ(backend.in_flight(), 0u) << info.name;
   }
-  std::filesystem::remove(profile);
   EXPECT_GT(rebuilds, 0u);  // the hierarchy was rebuilt under the cullers
   EXPECT_EQ(removed_seen, 0u);
 }

@@ -4,6 +4,7 @@
 #include "occull/cost_model.hpp"
 #include "occull/error.hpp"
 #include "occull/profile_io.hpp"
+#include "test_util.hpp"
 
 #include <gtest/gtest.h>
 
@@ -16,20 +17,7 @@ using namespace occull::detail;
 
 namespace {
 
-HardwareProfile test_profile() {
-  HardwareProfile p;
-  p.renderer = "test";
-  p.width = 100;
-  p.height = 100;
-  p.draw_setup_ms = 0.01;
-  p.triangle_ms = 1e-5;
-  p.fragment_ms = {{0, 1e-6}, {10, 11e-6}};
-  p.query_setup_ms = 0.02;
-  p.query_fragment_ms = 1e-7;
-  p.query_latency_ms = 0.2;
-  p.query_overhead_ms = 0.005;
-  return p;
-}
+HardwareProfile test_profile() { return test::hardware_profile(); }
 
 }  // namespace
 

@@ -53,24 +53,6 @@ void make_slow_and_changing(test::RecordingBackend& backend, const int& frame) {
   };
 }
 
-std::string profile_file() {
-  HardwareProfile p;
-  p.renderer = "test";
-  p.width = 64;
-  p.height = 64;
-  p.draw_setup_ms = 0.01;
-  p.triangle_ms = 1e-5;
-  p.fragment_ms = {{0, 1e-6}, {10, 11e-6}};
-  p.query_setup_ms = 0.02;
-  p.query_fragment_ms = 1e-7;
-  p.query_latency_ms = 0.2;
-  p.query_overhead_ms = 0.005;
-  const std::string file = (std::filesystem::temp_directory_path() /
-                            ("occull-ownership-" + std::to_string(::getpid()) + ".json")).string();
-  save_profile(p, file);
-  return file;
-}
-
 }  // namespace
 
 TEST(RecordingBackend, ReadingAQueryTwiceFailsLoudly) {
@@ -100,8 +82,8 @@ TEST(QueryOwnership, EveryBvhAlgorithmHandsBackEveryQuery) {
   Scene scene = moving_boxes();
   Bvh bvh = Bvh::build(scene);
   Options base;
-  const std::string profile = profile_file();
-  base.set("nohc.profile", profile);
+  const test::ProfileFile profile("occull-ownership-" + std::to_string(::getpid()) + ".json");
+  base.set("nohc.profile", profile.path());
   const View view = make_view({{0, 0, 0}, 0, 0}, {60.0f, 0.1f, 500.0f}, 64, 64);
   std::size_t held_somewhere = 0;
   for (const AlgorithmInfo& info : algorithms()) {
@@ -129,7 +111,6 @@ TEST(QueryOwnership, EveryBvhAlgorithmHandsBackEveryQuery) {
     culler->release(backend);
     EXPECT_EQ(backend.in_flight(), 0u) << info.name;
   }
-  std::filesystem::remove(profile);
   // The test means something only if some culler kept queries across frames.
   EXPECT_GT(held_somewhere, 0u);
 }

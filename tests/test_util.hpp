@@ -3,16 +3,52 @@
 #pragma once
 
 #include "occull/backend.hpp"
+#include "occull/cost_model.hpp"
+#include "occull/profile_io.hpp"
 #include "occull/scene.hpp"
 
 #include <glm/gtc/matrix_transform.hpp>
 
+#include <filesystem>
 #include <functional>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
 namespace occull::test {
+
+/// A fixed NOHC hardware profile (not this machine's), for tests that run nohc.
+inline HardwareProfile hardware_profile() {
+  HardwareProfile p;
+  p.renderer = "test";
+  p.width = 100;
+  p.height = 100;
+  p.draw_setup_ms = 0.01;
+  p.triangle_ms = 1e-5;
+  p.fragment_ms = {{0, 1e-6}, {10, 11e-6}};
+  p.query_setup_ms = 0.02;
+  p.query_fragment_ms = 1e-7;
+  p.query_latency_ms = 0.2;
+  p.query_overhead_ms = 0.005;
+  return p;
+}
+
+/// hardware_profile() in a file of its own (for --opt nohc.profile=FILE),
+/// removed when this goes.
+class ProfileFile {
+ public:
+  explicit ProfileFile(const std::string& name)
+      : path_((std::filesystem::temp_directory_path() / name).string()) {
+    save_profile(hardware_profile(), path_);
+  }
+  ~ProfileFile() { std::filesystem::remove(path_); }
+  ProfileFile(const ProfileFile&) = delete;
+  ProfileFile& operator=(const ProfileFile&) = delete;
+  [[nodiscard]] const std::string& path() const noexcept { return path_; }
+
+ private:
+  std::string path_;
+};
 
 /// A closed box mesh (12 triangles) spanning b, outward CCW faces.
 inline Mesh box_mesh(const Aabb& b) {

@@ -29,16 +29,7 @@ glm::mat4 gl_reversed() {
   return p;
 }
 glm::mat4 zero_to_one_reversed() { return glm::perspectiveRH_ZO(kFov, kAspect, kFar, kNear); }
-// Reversed-Z with an infinite far plane: depth = near / distance.
-glm::mat4 infinite_reversed() {
-  glm::mat4 p(0.0f);
-  const float f = 1.0f / std::tan(kFov / 2.0f);
-  p[0][0] = f / kAspect;
-  p[1][1] = f;
-  p[2][3] = -1.0f;
-  p[3][2] = kNear;
-  return p;
-}
+glm::mat4 infinite_reversed() { return perspective_reversed_infinite(kFov, kAspect, kNear); }
 
 void expect_same_planes(const Frustum& a, const Frustum& b, int sides, const char* what) {
   for (int i = 0; i < sides; ++i) {

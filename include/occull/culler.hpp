@@ -22,7 +22,10 @@ struct HardwareProfile;
 
 /// What a culler reads: the scene and its hierarchy, shared read-only by
 /// every culler instance. Both must outlive the cullers made from them; the
-/// owner updates the scene and refits the BVH between frames.
+/// owner changes the scene (Scene::update, set_transform, add_object,
+/// remove_object) and calls Bvh::refit between frames, and the cullers
+/// follow: per-object state grows with the scene, per-node state is carried
+/// over when the hierarchy is rebuilt (Bvh::generation).
 struct SceneIndex {
   const Scene& scene;
   const Bvh& bvh;

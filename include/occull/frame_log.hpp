@@ -36,10 +36,8 @@ struct FrameLog {
 /// logs the calls into it. Stats are the wrapped backend's. Queries issued
 /// before the current log was given are forwarded but not logged.
 ///
-/// Keep one for as long as the cullers that render through it (a culler may
-/// read its last frame's queries through the last backend it was given,
-/// e.g. when it is destroyed), and switch logs per frame with log_into().
-/// Precondition: `inner` outlives this object.
+/// Switch logs per frame with log_into(). Precondition: `inner` outlives
+/// this object.
 class LoggingBackend final : public Backend {
  public:
   explicit LoggingBackend(Backend& inner) : inner_(inner) {}

@@ -50,6 +50,12 @@ struct Lens {
   DepthMode depth = DepthMode::standard;
 };
 
+/// A reversed-Z perspective projection with an infinite far plane, for
+/// ClipSpace{DepthRange::zero_to_one, true}: depth = near / distance (1 at the
+/// near plane, 0 at infinity). fov_y in radians, aspect = width / height,
+/// near in scene units; all > 0.
+[[nodiscard]] glm::mat4 perspective_reversed_infinite(float fov_y, float aspect, float near) noexcept;
+
 /// "standard" or "reversed" (the --depth option). Throws InputError listing both.
 [[nodiscard]] DepthMode parse_depth_mode(std::string_view name);
 

@@ -109,6 +109,16 @@ View make_view(const glm::mat4& view, const glm::mat4& proj, int width, int heig
   return v;
 }
 
+glm::mat4 perspective_reversed_infinite(float fov_y, float aspect, float near) noexcept {
+  glm::mat4 proj(0.0f);
+  const float f = 1.0f / std::tan(fov_y / 2.0f);
+  proj[0][0] = f / aspect;
+  proj[1][1] = f;
+  proj[2][3] = -1.0f;  // w = distance along the view axis
+  proj[3][2] = near;   // z = near, so depth = near / distance
+  return proj;
+}
+
 DepthMode parse_depth_mode(std::string_view name) {
   if (name == "standard") return DepthMode::standard;
   if (name == "reversed") return DepthMode::reversed;
@@ -138,14 +148,8 @@ View make_view(const CameraPose& pose, const Lens& lens, int width, int height) 
   const float aspect = float(width) / float(height);
   View v;
   if (lens.depth == DepthMode::reversed) {
-    // Depth = near / distance: 1 at the near plane, 0 at infinity.
-    glm::mat4 proj(0.0f);
-    const float f = 1.0f / std::tan(glm::radians(lens.fov_y_degrees) / 2.0f);
-    proj[0][0] = f / aspect;
-    proj[1][1] = f;
-    proj[2][3] = -1.0f;
-    proj[3][2] = lens.near;
-    v = make_view(view, proj, width, height, {DepthRange::zero_to_one, true});
+    v = make_view(view, perspective_reversed_infinite(glm::radians(lens.fov_y_degrees), aspect, lens.near), width,
+                  height, {DepthRange::zero_to_one, true});
   } else {
     v = make_view(view, glm::perspective(glm::radians(lens.fov_y_degrees), aspect, lens.near, lens.far), width,
                   height);
