@@ -3,7 +3,6 @@
 # which implements a Backend and renders frames) against it with
 # find_package(occull).
 set(prefix "${WORK_DIR}/prefix")
-set(consumer_build "${WORK_DIR}/consumer")
 file(REMOVE_RECURSE "${WORK_DIR}")
 execute_process(COMMAND "${CMAKE_COMMAND}" --install "${BUILD_DIR}" --prefix "${prefix}"
                 RESULT_VARIABLE rc OUTPUT_QUIET)
@@ -15,33 +14,25 @@ set(flags "")
 if(SANITIZE)
   set(flags "-DCMAKE_CXX_FLAGS=-fsanitize=address,undefined" "-DCMAKE_EXE_LINKER_FLAGS=-fsanitize=address,undefined")
 endif()
-execute_process(COMMAND "${CMAKE_COMMAND}" -S "${SOURCE_DIR}/tests/consumer" -B "${consumer_build}"
-                        -G Ninja -DCMAKE_PREFIX_PATH=${prefix} -DCMAKE_BUILD_TYPE=Release ${flags}
-                RESULT_VARIABLE rc)
-if(rc)
-  message(FATAL_ERROR "configuring the consumer with find_package(occull) failed: ${rc}")
-endif()
-execute_process(COMMAND "${CMAKE_COMMAND}" --build "${consumer_build}" RESULT_VARIABLE rc)
-if(rc)
-  message(FATAL_ERROR "building the consumer failed: ${rc}")
-endif()
-execute_process(COMMAND "${consumer_build}/consumer" RESULT_VARIABLE rc)
-if(rc)
-  message(FATAL_ERROR "the consumer failed: ${rc}")
-endif()
+# Configures, builds and runs the project in SOURCE_DIR/FOLDER against the
+# installed package; WHAT names it in failures, ARGN are its arguments.
+function(build_and_run what folder program)
+  set(build "${WORK_DIR}/${program}")
+  execute_process(COMMAND "${CMAKE_COMMAND}" -S "${SOURCE_DIR}/${folder}" -B "${build}"
+                          -G Ninja -DCMAKE_PREFIX_PATH=${prefix} -DCMAKE_BUILD_TYPE=Release ${flags}
+                  RESULT_VARIABLE rc)
+  if(rc)
+    message(FATAL_ERROR "configuring ${what} with find_package(occull) failed: ${rc}")
+  endif()
+  execute_process(COMMAND "${CMAKE_COMMAND}" --build "${build}" RESULT_VARIABLE rc)
+  if(rc)
+    message(FATAL_ERROR "building ${what} failed: ${rc}")
+  endif()
+  execute_process(COMMAND "${build}/${program}" ${ARGN} RESULT_VARIABLE rc)
+  if(rc)
+    message(FATAL_ERROR "${what} failed: ${rc}")
+  endif()
+endfunction()
 
-set(engine_build "${WORK_DIR}/engine")
-execute_process(COMMAND "${CMAKE_COMMAND}" -S "${SOURCE_DIR}/examples/engine" -B "${engine_build}"
-                        -G Ninja -DCMAKE_PREFIX_PATH=${prefix} -DCMAKE_BUILD_TYPE=Release ${flags}
-                RESULT_VARIABLE rc)
-if(rc)
-  message(FATAL_ERROR "configuring the example engine with find_package(occull) failed: ${rc}")
-endif()
-execute_process(COMMAND "${CMAKE_COMMAND}" --build "${engine_build}" RESULT_VARIABLE rc)
-if(rc)
-  message(FATAL_ERROR "building the example engine failed: ${rc}")
-endif()
-execute_process(COMMAND "${engine_build}/occull_example_engine" --frames 20 --size 96x54 RESULT_VARIABLE rc)
-if(rc)
-  message(FATAL_ERROR "the example engine failed: ${rc}")
-endif()
+build_and_run("the consumer" tests/consumer consumer)
+build_and_run("the example engine" examples/engine occull_example_engine --frames 20 --size 96x54)

@@ -130,6 +130,7 @@ class Bvh {
   std::vector<std::uint8_t> marked_;  // refit()'s scratch: nodes to refit
   double weighted_area_ = 0.0;     // sum over nodes of area x SAH weight, kept by refit()
   void finish_build();             // leaf_of_, built_sah_ of a new tree
+  void rebuild(const Scene& scene);  // a new build with options_, the next generation
   [[nodiscard]] double sah_of_weighted_area() const;  // sah_cost() from weighted_area_
 };
 

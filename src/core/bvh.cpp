@@ -221,12 +221,7 @@ Bvh Bvh::instance(const glm::vec3& offset, ObjectId first_object) const {
 }
 
 void Bvh::refit(const Scene& scene) {
-  if (scene.objects().size() != built_objects_) {  // objects added: new leaves
-    const std::uint64_t generation = generation_;
-    *this = build(scene, options_);
-    generation_ = generation + 1;
-    return;
-  }
+  if (scene.objects().size() != built_objects_) return rebuild(scene);  // objects added: new leaves
   const auto objects = scene.objects();
   // Refits node n from its objects or children, keeping weighted_area_ (the
   // SAH cost times the root's area) up to date as it goes.
@@ -278,11 +273,13 @@ void Bvh::refit(const Scene& scene) {
     }
   if (root_stale) refit_node(root());
   // Boxes that moved far loosen the tree: rebuild when it got too costly.
-  if (changed && sah_of_weighted_area() > kRebuildFactor * built_sah_) {
-    const std::uint64_t generation = generation_;
-    *this = build(scene, options_);
-    generation_ = generation + 1;
-  }
+  if (changed && sah_of_weighted_area() > kRebuildFactor * built_sah_) rebuild(scene);
+}
+
+void Bvh::rebuild(const Scene& scene) {
+  const std::uint64_t generation = generation_;
+  *this = build(scene, options_);
+  generation_ = generation + 1;
 }
 
 double Bvh::sah_of_weighted_area() const {
