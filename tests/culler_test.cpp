@@ -138,3 +138,61 @@ TEST(MakeCuller, TakesSpecsWithOptionsAndAProfileInMemory) {
   auto with_nohc = make_culler("auto:candidates=vfc+nohc", {scene, bvh}, {}, context);
   EXPECT_NE(with_nohc, nullptr);
 }
+
+TEST(Registry, EveryDefaultShownIsAValueItsAlgorithmTakes) {
+  for (const AlgorithmInfo& a : algorithms()) {
+    if (a.harness_only) continue;
+    const bool conservative = is_conservative(parse_algorithm_spec(a.name));
+    for (const OptionInfo& o : a.options) {
+      if (o.default_value.starts_with("(")) continue;  // a placeholder: "(calibrated)"
+      const std::string spec = a.name + ":" + o.key + "=" + o.default_value;
+      SCOPED_TRACE(spec);
+      // is_conservative parses every option of the spec: it throws for a value the table refuses.
+      EXPECT_EQ(is_conservative(parse_algorithm_spec(spec)), conservative);
+    }
+  }
+}
+
+TEST(Registry, ApproximationIsJudgedOnTheParsedValue) {
+  EXPECT_TRUE(is_conservative(parse_algorithm_spec("chc:threshold=00")));
+  EXPECT_TRUE(is_conservative(parse_algorithm_spec("tiles:box=common")));
+  EXPECT_FALSE(is_conservative(parse_algorithm_spec("tiles:box=tile")));
+  EXPECT_FALSE(is_conservative(parse_algorithm_spec("stopwait:threshold=1")));
+}
+
+TEST(MakeCuller, AValueOutOfRangeNamesTheKeyAndTheRange) {
+  const Scene scene = test::box_scene({{{-1, -1, -10}, {1, 1, -8}}});
+  const Bvh bvh = Bvh::build(scene);
+  for (const auto& [spec, says] : std::vector<std::pair<std::string, std::string>>{
+           {"chcpp:batch=0", "chcpp.batch: 0 is outside [1, 100000]"},
+           {"grid:traversal=spiral", "grid.traversal: 'spiral' is not one of frustum, box"},
+           {"chc:skip=x", "chc.skip: 'x' is not a whole number"},
+           {"nohc:visible_factor=2", "nohc.visible_factor: 2 is outside [0, 1]"}}) {
+    try {
+      (void)make_culler(spec, {scene, bvh});
+      ADD_FAILURE() << spec << ": no error";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(says), std::string::npos) << e.what();
+    }
+  }
+}
+
+TEST(MakeCuller, AsksTheContextForNohcsProfileOnlyWhenACullerNeedsIt) {
+  const Scene scene = test::box_scene({{{-1, -1, -10}, {1, 1, -8}}});
+  const Bvh bvh = Bvh::build(scene);
+  const HardwareProfile profile = test::hardware_profile();
+  int asked = 0;
+  CullerContext context;
+  context.nohc_profile_source = [&]() -> const HardwareProfile& {
+    ++asked;
+    return profile;
+  };
+  (void)make_culler("chcpp", {scene, bvh}, {}, context);
+  (void)make_culler("auto:candidates=chcpp+vfc", {scene, bvh}, {}, context);
+  EXPECT_EQ(asked, 0);
+  (void)make_culler("nohc", {scene, bvh}, {}, context);
+  EXPECT_EQ(asked, 1);
+  (void)make_culler("auto", {scene, bvh}, {}, context);  // the default candidates take nohc when a profile is at hand
+  EXPECT_EQ(asked, 2);
+  (void)make_culler("auto", {scene, bvh});  // ... and leave it out when none is
+}

@@ -183,7 +183,8 @@ int cmd_algos() {
                : has_threshold ? " (conservative; threshold > 0 makes a run approximate)"
                                : " (conservative)");
     for (const auto& o : a.options)
-      fmt::print("    --opt {}.{}={}  {}\n", a.name, o.key, o.default_value, o.help);
+      fmt::print("    --opt {}.{}={}  {}{}\n", a.name, o.key, o.default_value,
+                 o.values.empty() ? "" : fmt::format("({}) ", o.values), o.help);
   }
   return 0;
 }

@@ -8,11 +8,11 @@
 #include "occull/tiles.hpp"
 #include "occull/view.hpp"
 
+#include <functional>
 #include <map>
 #include <memory>
 #include <span>
 #include <string>
-#include <initializer_list>
 #include <string_view>
 #include <vector>
 
@@ -35,7 +35,8 @@ struct SceneIndex {
 };
 
 /// Algorithm options as "algorithm.key" -> "value" strings, e.g.
-/// "chcpp.batch" -> "50". Cullers read their own keys with typed getters;
+/// "chcpp.batch" -> "50". Each algorithm reads its own keys into its typed
+/// config (one table per algorithm: key, member, range, default, help);
 /// make_culler() rejects unknown keys of the algorithm it makes.
 class Options {
  public:
@@ -53,9 +54,6 @@ class Options {
                                   double hi) const;
   /// Accepts on/off, true/false, yes/no, 1/0.
   [[nodiscard]] bool get_bool(const std::string& key, bool fallback) const;
-  /// One of `choices` (fallback when absent); InputError listing them otherwise.
-  [[nodiscard]] std::string get_choice(const std::string& key, std::string_view fallback,
-                                       std::initializer_list<std::string_view> choices) const;
 
  private:
   std::map<std::string, std::string> values_;
@@ -163,6 +161,7 @@ class Culler {
 struct OptionInfo {
   std::string key;            ///< without the algorithm prefix
   std::string default_value;
+  std::string values;         ///< what it takes: "[1, 100000]", "on|off", "frustum|box"; empty: any text
   std::string help;
   /// Any value but the default may cull visible objects (a sample
   /// threshold, tiles.box=tile): is_conservative() says no for such a run.
@@ -228,10 +227,19 @@ void check_options(const Options& options);
 
 /// What an algorithm may need beyond its options, from the program that
 /// makes it. Pointers are borrowed: they must outlive make_culler() only.
+///
+/// nohc's calibrated hardware cost model (occull/cost_model.hpp) comes from,
+/// in this order: the file its option nohc.profile names; `nohc_profile`;
+/// `nohc_profile_source()`. Without any, making nohc throws InputError, and
+/// auto's default candidates leave nohc out.
 struct CullerContext {
-  /// nohc's calibrated hardware cost model (occull/cost_model.hpp) in
-  /// memory; without it nohc reads the file its option nohc.profile names.
+  /// A profile in memory (e.g. one from gl::calibrate).
   const HardwareProfile* nohc_profile = nullptr;
+  /// Called only when a culler needs a profile and none of the above gives
+  /// one: e.g. loads a cached profile or calibrates one now (Session::make
+  /// does, taking seconds on first use). The reference must outlive
+  /// make_culler().
+  std::function<const HardwareProfile&()> nohc_profile_source;
 };
 
 /// Makes a culler from an algorithm spec: a name ("chcpp") or a name with

@@ -182,9 +182,14 @@ class Session {
 
   /// Makes a culler from an algorithm spec ("chcpp" or
   /// "chcpp:multiquery=off", see parse_algorithm_spec) for this scene;
-  /// `oracle` too (run_path feeds it the truth). Throws InputError like
-  /// make_culler().
-  [[nodiscard]] std::unique_ptr<Culler> make(std::string_view spec, const Options& options);
+  /// `oracle` too (run_path feeds it the truth). A culler that needs nohc's
+  /// hardware profile and is given no file gets hardware_profile(), which
+  /// calibrates on first use (its lines go to `progress`). Throws
+  /// InputError like make_culler().
+  [[nodiscard]] std::unique_ptr<Culler> make(std::string_view spec, const Options& options,
+                                             const std::function<void(const std::string&)>& progress = {});
+  /// Whether hardware_profile() has been loaded or calibrated in this session.
+  [[nodiscard]] bool has_hardware_profile() const noexcept { return profile_.has_value(); }
 
   /// Runs `culler` over frames 0..frames-1 of `path`. With `truth` (one
   /// entry per frame), verifies every frame; the oracle needs it.

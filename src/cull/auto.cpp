@@ -148,33 +148,42 @@ class AutoCuller final : public Culler {
 
 }  // namespace
 
-std::unique_ptr<Culler> make_auto(const SceneIndex& index, const Options& o, const CullerContext& context) {
-  AutoConfig c;
-  c.trial = o.get_int("auto.trial", c.trial, 1, 1000);
-  c.period = o.get_int("auto.period", c.period, 1, 1000000);
-  c.margin = o.get_double("auto.margin", c.margin, 0.0, 0.9);
-  const auto it = o.values().find("auto.candidates");
-  if (it != o.values().end()) {
-    c.candidates.clear();
-    std::string_view rest = it->second;
-    while (!rest.empty()) {
-      const auto plus = rest.find('+');
-      c.candidates.emplace_back(rest.substr(0, plus));
-      rest = plus == std::string_view::npos ? std::string_view{} : rest.substr(plus + 1);
-    }
-  } else if (!o.has("nohc.profile") && !context.nohc_profile) {
-    // nohc needs a calibrated profile; without one (occull bench passes it)
-    // the default candidates are chcpp and vfc.
-    c.candidates = {"chcpp", "vfc"};
-  }
-  if (c.candidates.empty()) throw InputError("option auto.candidates: no candidate given (e.g. chcpp+vfc+nohc)");
-  std::vector<std::unique_ptr<Culler>> cullers;
-  for (const std::string& name : c.candidates) {
-    if (name == "auto" || name == "oracle")
-      throw InputError(fmt::format("option auto.candidates: '{}' cannot be a candidate", name));
-    cullers.push_back(make_culler(name, index, o, context));
-  }
-  return std::make_unique<AutoCuller>(index, std::move(cullers), c);
+Registration auto_registration() {
+  using C = AutoConfig;
+  static const ConfigTable<C> table =
+      ConfigTable<C>()
+          .text("candidates", &C::candidates,
+                "cullers to choose among, joined by +, tried in this order (by default nohc only where a profile is at "
+                "hand, as occull bench has)")
+          .integer("trial", &C::trial, 1, 1000,
+                   "frames a candidate runs when tried (its cost: their median, per unit of frame content)")
+          .integer("period", &C::period, 1, 1000000,
+                   "frames between tries of a challenger (doubled after each lost try, up to 16x)")
+          .real("margin", &C::margin, 0.0, 0.9,
+                "a challenger must be this much cheaper to take over (frame times of one culler vary more than 5 % "
+                "between frames)");
+  return registered(
+      {"auto", "adaptive: runs the cheapest of chcpp, vfc and nohc for this view, learnt from the measured frame "
+               "times, with hysteresis"},
+      table, [](const SceneIndex& index, const C& c, const Options& o, const CullerContext& context) {
+        std::vector<std::string> names;
+        for (std::string_view rest = c.candidates; !rest.empty();) {
+          const auto plus = rest.find('+');
+          names.emplace_back(rest.substr(0, plus));
+          rest = plus == std::string_view::npos ? std::string_view{} : rest.substr(plus + 1);
+        }
+        // nohc needs a calibrated profile; without one the default candidates leave it out.
+        if (!o.has("auto.candidates") && !o.has("nohc.profile") && !has_nohc_profile(context))
+          std::erase(names, "nohc");
+        if (names.empty()) throw InputError("option auto.candidates: no candidate given (e.g. chcpp+vfc+nohc)");
+        std::vector<std::unique_ptr<Culler>> cullers;
+        for (const std::string& name : names) {
+          if (name == "auto" || name == "oracle")
+            throw InputError(fmt::format("option auto.candidates: '{}' cannot be a candidate", name));
+          cullers.push_back(make_culler(name, index, o, context));
+        }
+        return std::make_unique<AutoCuller>(index, std::move(cullers), c);
+      });
 }
 
 }  // namespace occull::detail

@@ -11,7 +11,7 @@ namespace occull::detail {
 struct AutoConfig {
   // Tried in this order at the start: chcpp first, so that a candidate far
   // worse than it (vfc in a dense city) is dropped after one frame.
-  std::vector<std::string> candidates{"chcpp", "vfc", "nohc"};
+  std::string candidates = "chcpp+vfc+nohc";  ///< joined by +
   int trial = 2;          ///< frames a candidate runs when tried (its cost: their median)
   int period = 50;        ///< frames between tries of a challenger
   double margin = 0.15;   ///< a challenger must be this much cheaper to take over (hysteresis)

@@ -24,14 +24,16 @@
 namespace occull::detail {
 namespace {
 
+struct ChcConfig {
+  CommonOptions common;
+  std::uint32_t skip = 0;         ///< n_av
+  std::uint32_t flush_every = 8;  ///< queries handed to the device together
+};
+
 class ChcCuller final : public Culler {
  public:
-  ChcCuller(const SceneIndex& index, const Options& options)
-      : index_(index),
-        common_(read_common_options(options, "chc")),
-        skip_(std::uint32_t(options.get_int("chc.skip", 0, 0, 1000))),
-        state_(index.bvh.size()),
-        submitter_(std::uint32_t(options.get_int("chc.flush_every", 8, 1, 1 << 20))) {}
+  ChcCuller(const SceneIndex& index, const ChcConfig& c)
+      : index_(index), common_(c.common), skip_(c.skip), state_(index.bvh.size()), submitter_(c.flush_every) {}
 
   FrameStats cull(const View& view, Backend& backend) override {
     ++frame_;
@@ -135,8 +137,17 @@ class ChcCuller final : public Culler {
 
 }  // namespace
 
-std::unique_ptr<Culler> make_chc(const SceneIndex& index, const Options& options, const CullerContext&) {
-  return std::make_unique<ChcCuller>(index, options);
+Registration chc_registration() {
+  static const ConfigTable<ChcConfig> table =
+      with_common_options(ConfigTable<ChcConfig>(), &ChcConfig::common)
+          .integer("skip", &ChcConfig::skip, 0, 1000,
+                   "n_av: a visible leaf is assumed visible for n_av frames, queried in frame n_av+1")
+          .integer("flush_every", &ChcConfig::flush_every, 1, 1 << 20,
+                   "hand queries to the device this many at a time, and poll only those handed over (1: each at once)");
+  return registered({"chc", "coherent hierarchical culling (Bittner & Wimmer 2004; seed 000 Listing 8.4.1)"}, table,
+                    [](const SceneIndex& index, const ChcConfig& c, const Options&, const CullerContext&) {
+                      return std::make_unique<ChcCuller>(index, c);
+                    });
 }
 
 }  // namespace occull::detail

@@ -99,28 +99,6 @@ std::uint32_t first_requery_delay(std::uint32_t n_av, std::uint64_t random) {
 
 namespace {
 
-ChcppConfig read_config(const Options& o) {
-  ChcppConfig c;
-  c.batch = std::uint32_t(o.get_int("chcpp.batch", int(c.batch), 1, 100000));
-  c.v_queue = o.get_bool("chcpp.vqueue", c.v_queue);
-  c.multiquery = o.get_bool("chcpp.multiquery", c.multiquery);
-  c.jitter = o.get_bool("chcpp.jitter", c.jitter);
-  c.n_av = std::uint32_t(o.get_int("chcpp.n_av", int(c.n_av), 1, 1000));
-  c.shape.tight = o.get_bool("chcpp.tight", c.shape.tight);
-  c.shape.d_max = o.get_int("chcpp.d_max", c.shape.d_max, 0, 16);
-  c.shape.s_max = float(o.get_double("chcpp.s_max", c.shape.s_max, 1.0, 100.0));
-  c.common = read_common_options(o, "chcpp", c.common.virtual_leaf_triangles);
-  c.leaf_objects = std::uint32_t(o.get_int("chcpp.leaf_objects", int(c.leaf_objects), 0, 1 << 30));
-  c.pkeep_min_samples = std::uint32_t(o.get_int("chcpp.pkeep_samples", int(c.pkeep_min_samples), 1, 1 << 24));
-  c.flush_batches = o.get_bool("chcpp.flush", c.flush_batches);
-  c.render_batch_triangles =
-      std::uint64_t(o.get_int("chcpp.render_batch", int(c.render_batch_triangles), 0, 1 << 30));
-  c.seed = std::uint64_t(o.get_int("chcpp.seed", int(c.seed), 0, 1 << 30));
-  c.enter_p_min = o.get_double("chcpp.enter_p_min", c.enter_p_min, 0.0, 1.0);
-  c.backoff = std::uint32_t(o.get_int("chcpp.backoff", int(c.backoff), 0, 10));
-  c.gate_depth = o.get_int("chcpp.gate_depth", c.gate_depth, 0, 30);
-  return c;
-}
 
 // SplitMix64, for the jitter: deterministic for a given seed.
 std::uint64_t next_random(std::uint64_t& state) {
@@ -427,8 +405,44 @@ class ChcppCuller final : public Culler {
 
 }  // namespace
 
-std::unique_ptr<Culler> make_chcpp(const SceneIndex& index, const Options& options, const CullerContext&) {
-  return std::make_unique<ChcppCuller>(index, read_config(options));
+Registration chcpp_registration() {
+  using C = ChcppConfig;
+  static const ConfigTable<C> table =
+      with_common_options(ConfigTable<C>(), &C::common)
+          .integer("batch", &C::batch, 1, 100000, "b: previously invisible nodes per query batch (1: no batching)")
+          .flag("vqueue", &C::v_queue, "defer queries of visible leaves to fill idle time (off: query each at once)")
+          .flag("multiquery", &C::multiquery, "group previously invisible nodes into multiqueries by p_keep")
+          .flag("jitter", &C::jitter, "first re-query of a newly visible leaf after a random 0 < r < n_av frames")
+          .integer("n_av", &C::n_av, 1, 1000, "frames between queries of a visible leaf")
+          .flag("tight", [](auto& c) -> auto& { return c.shape.tight; },
+                "query with the descendants' boxes (tighter bounding volumes)")
+          .integer("d_max", [](auto& c) -> auto& { return c.shape.d_max; }, 0, 16, "tight bounds: levels below the node")
+          .real("s_max", [](auto& c) -> auto& { return c.shape.s_max; }, 1.0, 100.0,
+                "tight bounds: most total surface area, relative to the node's")
+          .integer("leaf_objects", &C::leaf_objects, 0, 1 << 30,
+                   "... and with at most this many objects (0: any number; 8 cost more queries than it saved on "
+                   "track/lap)")
+          .integer("pkeep_samples", &C::pkeep_min_samples, 1, 1 << 24,
+                   "tests at persistence i before the measured p_keep(i) replaces the formula")
+          .integer("seed", &C::seed, 0, 1 << 30, "random seed of the jitter")
+          .flag("flush", &C::flush_batches, "flush the device after each query batch so its results come back sooner")
+          .integer("render_batch", &C::render_batch_triangles, 0, 1 << 30,
+                   "also hand the render queue over (and flush) once it holds this many triangles; 0: only before "
+                   "query batches")
+          .real("enter_p_min", &C::enter_p_min, 0.0, 1.0,
+                "query nodes entering the view (not occluded last frame) only in BVH regions where at least this "
+                "share of them was found occluded; elsewhere draw them and learn from their first re-query (0: "
+                "always query, as CHC++)")
+          .integer("backoff", &C::backoff, 0, 10,
+                   "a visible leaf found visible again k times in a row waits n_av * 2^min(k-1, backoff) frames for "
+                   "its next query (0: always n_av)")
+          .integer("gate_depth", &C::gate_depth, 0, 30, "BVH depth of the regions that learn that share each on their own");
+  return registered({"chcpp",
+                     "CHC++: batched i/v-queues, render queue, multiqueries, jittered re-queries, tight bounds (seed "
+                     "000)"},
+                    table, [](const SceneIndex& index, const C& c, const Options&, const CullerContext&) {
+                      return std::make_unique<ChcppCuller>(index, c);
+                    });
 }
 
 }  // namespace occull::detail

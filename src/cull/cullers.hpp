@@ -1,23 +1,30 @@
-// Internal: the factory of each algorithm (one file per algorithm).
+// Internal: the registration of each algorithm (one file per algorithm):
+// its name, summary, option table and factory (config_table.hpp).
 #pragma once
 
-#include "occull/culler.hpp"
-
-#include <memory>
+#include "config_table.hpp"
 
 namespace occull::detail {
 
-std::unique_ptr<Culler> make_none(const SceneIndex& index, const Options& options, const CullerContext& context);
-std::unique_ptr<Culler> make_vfc(const SceneIndex& index, const Options& options, const CullerContext& context);
-std::unique_ptr<Culler> make_stopwait(const SceneIndex& index, const Options& options, const CullerContext& context);
-std::unique_ptr<Culler> make_perobject(const SceneIndex& index, const Options& options, const CullerContext& context);
-std::unique_ptr<Culler> make_chc(const SceneIndex& index, const Options& options, const CullerContext& context);
-std::unique_ptr<Culler> make_chcpp(const SceneIndex& index, const Options& options, const CullerContext& context);
-std::unique_ptr<Culler> make_nohc(const SceneIndex& index, const Options& options, const CullerContext& context);
-std::unique_ptr<Culler> make_grid(const SceneIndex& index, const Options& options, const CullerContext& context);
-std::unique_ptr<Culler> make_auto(const SceneIndex& index, const Options& options, const CullerContext& context);
-std::unique_ptr<Culler> make_tilevfc(const SceneIndex& index, const Options& options, const CullerContext& context);
-std::unique_ptr<Culler> make_pertile(const SceneIndex& index, const Options& options, const CullerContext& context);
-std::unique_ptr<Culler> make_tiles(const SceneIndex& index, const Options& options, const CullerContext& context);
+Registration none_registration();
+Registration vfc_registration();
+Registration stopwait_registration();
+Registration perobject_registration();
+Registration chc_registration();
+Registration chcpp_registration();
+Registration nohc_registration();
+Registration grid_registration();
+Registration auto_registration();
+Registration tilevfc_registration();
+Registration pertile_registration();
+Registration tiles_registration();
+
+/// nohc's hardware profile for a culler: the file `file` names (the option
+/// nohc.profile), else `context.nohc_profile`, else
+/// `context.nohc_profile_source()`. Throws
+/// InputError when there is none, or the file does not exist.
+HardwareProfile nohc_profile(const CullerContext& context, const std::string& file);
+/// Whether nohc_profile() would find a profile without a file.
+bool has_nohc_profile(const CullerContext& context);
 
 }  // namespace occull::detail

@@ -75,6 +75,9 @@ struct GridConfig {
   std::optional<ConditionalWait> conditional = ConditionalWait::wait;  // none: off
   std::uint64_t threshold = 0;
   std::uint32_t seed = 1;
+  // Split screen (GridViews) only.
+  QueryBudget::Policy split = QueryBudget::Policy::reveal;
+  double split_floor = 1.0;
 };
 
 class GridCuller final : public Culler {
@@ -295,32 +298,62 @@ class GridCuller final : public Culler {
 
 namespace {
 
-GridConfig grid_config(const Options& o) {
-  GridConfig c;
-  c.cell = float(o.get_double("grid.cell", 0.0, 0.0, 1e9));
-  if (o.get_choice("grid.traversal", "frustum", {"frustum", "box"}) == "box") c.traversal = GridTraversal::Mode::box;
-  c.cap = o.get_int("grid.cap", c.cap, 1, 1 << 24);
-  c.vis_duration = o.get_int("grid.vis_duration", c.vis_duration, 1, 1 << 16);
-  c.vis_growth = o.get_int("grid.vis_growth", c.vis_growth, 0, 1 << 16);
-  c.invis_duration = o.get_int("grid.invis_duration", c.invis_duration, 1, 1 << 16);
-  c.invis_growth = o.get_int("grid.invis_growth", c.invis_growth, 0, 1 << 16);
-  c.prepass = o.get_int("grid.prepass", c.prepass, 0, 1 << 24);
-  c.unknown_visible = o.get_choice("grid.unknown", "visible", {"visible", "hidden"}) == "visible";
-  c.tight = o.get_bool("grid.tight", c.tight);
-  c.latency = o.get_int("grid.latency", c.latency, 0, 1);
-  const std::string conditional = o.get_choice("grid.conditional", "wait", {"wait", "no_wait", "off"});
-  if (conditional == "off") c.conditional.reset();
-  if (conditional == "no_wait") c.conditional = ConditionalWait::no_wait;
-  c.threshold = std::uint64_t(o.get_int("grid.threshold", 0, 0, 1 << 24));
-  c.seed = std::uint32_t(o.get_int("grid.seed", 1, 0, 1 << 30));
-  return c;
+const ConfigTable<GridConfig>& grid_table() {
+  using C = GridConfig;
+  static const ConfigTable<C> table =
+      ConfigTable<C>()
+          .real("cell", &C::cell, 0.0, 1e9,
+                "cell edge, scene units (0: twice the median object size, at most 256 cells along the scene)")
+          .choice("traversal", &C::traversal,
+                  {{"frustum", GridTraversal::Mode::frustum}, {"box", GridTraversal::Mode::box}},
+                  "frustum: rasterize the frustum slice by slice; box: every cell of its bounding box")
+          .integer("cap", &C::cap, 1, 1 << 24, "queries per frame; cells visible by their last answer are queried past it")
+          .integer("vis_duration", &C::vis_duration, 1, 1 << 16, "frames a visible answer holds")
+          .integer("vis_growth", &C::vis_growth, 0, 1 << 16, "... longer by this per consecutive frame that hit the cap")
+          .integer("invis_duration", &C::invis_duration, 1, 1 << 16,
+                   "frames an occluded answer holds (1: query again next frame)")
+          .integer("invis_growth", &C::invis_growth, 0, 1 << 16,
+                   "... longer by this per consecutive frame that hit the cap")
+          .integer("prepass", &C::prepass, 0, 1 << 24,
+                   "occluders of class sometimes drawn in the pre-pass per frame (class always: all)")
+          .choice("unknown", &C::unknown_visible, {{"visible", true}, {"hidden", false}},
+                  "a cell the frustum did not meet last frame: visible (draw it while its query runs) or hidden (the "
+                  "thesis: it pops in a frame late)")
+          .flag("tight", &C::tight, "query the box of what a cell holds instead of the whole cell")
+          .integer("latency", &C::latency, 0, 1,
+                   "frames before a hidden cell's answer is used: 0 waits for it after the colour pass and draws the "
+                   "cells found visible in the same frame; 1 uses it next frame (the thesis: they pop in a frame "
+                   "late)")
+          .choice("conditional", &C::conditional,
+                  std::vector<std::pair<std::string, std::optional<ConditionalWait>>>{
+                      {"wait", ConditionalWait::wait}, {"no_wait", ConditionalWait::no_wait}, {"off", std::nullopt}},
+                  "pre-pass of a cell queried this frame under conditional rendering on its query: wait (the device "
+                  "waits for the result), no_wait (draws while it is unknown) or off")
+          .integer("threshold", &C::threshold, 0, 1 << 24, "a cell is visible when more samples (pixels) pass")
+          .approximate_unless_default()
+          .integer("seed", &C::seed, 0, 1 << 30, "random seed of the answers' extra duration when capped")
+          .choice("split", &C::split, {{"reveal", QueryBudget::Policy::reveal}, {"even", QueryBudget::Policy::even}},
+                  "split screen (bench --views): how the views share the cap; reveal: an even split of what the "
+                  "queries of drawn cells leave, capped at each view's recent peak demand, and what a view does not "
+                  "need lent in proportion to demand x share of its re-queries of hidden cells that found them "
+                  "visible (measured: less popping than even); even: cap / views each")
+          .real("split_floor", &C::split_floor, 0.0, 1.0,
+                "with split=reveal: share of an even split of what the queries of drawn cells leave each view is "
+                "sure of (below 1, more goes by reveal rate)");
+  return table;
 }
 
 }  // namespace
 
-std::unique_ptr<Culler> make_grid(const SceneIndex& index, const Options& o, const CullerContext&) {
-  const GridConfig c = grid_config(o);
-  return std::make_unique<GridCuller>(index, c, std::make_shared<UniformGrid>(UniformGrid::of_scene(index.scene, c.cell)));
+Registration grid_registration() {
+  return registered({"grid",
+                     "uniform grid in occlusion order, cell queries read a frame later, occluder pre-pass, per-frame "
+                     "query cap (Seletsky, seed 003); may pop",
+                     false},
+                    grid_table(), [](const SceneIndex& index, const GridConfig& c, const Options&, const CullerContext&) {
+                      return std::make_unique<GridCuller>(
+                          index, c, std::make_shared<UniformGrid>(UniformGrid::of_scene(index.scene, c.cell)));
+                    });
 }
 
 }  // namespace occull::detail
@@ -407,12 +440,9 @@ void QueryBudget::split() {
 GridViews::GridViews(const SceneIndex& index, int views, const Options& options) {
   if (views < 1 || views > 16) throw InputError(fmt::format("{} views: must be in [1, 16]", views));
   check_options(options);
-  const detail::GridConfig c = detail::grid_config(options);
+  const detail::GridConfig c = detail::grid_table().parse(options, "grid");
   grid_ = std::make_shared<UniformGrid>(UniformGrid::of_scene(index.scene, c.cell));
-  const double floor = options.get_double("grid.split_floor", 1.0, 0.0, 1.0);
-  const bool even = options.get_choice("grid.split", "reveal", {"reveal", "even"}) == "even";
-  budget_ = std::make_shared<QueryBudget>(std::max(c.cap, views), views, floor,
-                                          even ? QueryBudget::Policy::even : QueryBudget::Policy::reveal);
+  budget_ = std::make_shared<QueryBudget>(std::max(c.cap, views), views, c.split_floor, c.split);
   for (int k = 0; k < views; ++k) {
     detail::GridConfig view_config = c;
     view_config.seed = c.seed + std::uint32_t(k);

@@ -82,13 +82,13 @@ double OcclusionCalibration::scale(PreviousState previous, double p) const {
 namespace {
 
 struct NohcConfig {
-  std::uint64_t threshold = 0;
+  CommonOptions common;
+  std::string profile;           // hardware profile file (empty: the context's)
   double fragments_per_pixel = 2.0;
   double visible_factor = 0.5;   // p_occl = factor · p_cov^2 for previously visible nodes
   double levels = 0.0;           // 0: log2(N_h + 1)
   int max_parallel = 0;          // 0: N_q from the profile
   bool exact_area = true;        // projected box area instead of the paper's approximation
-  std::uint32_t virtual_leaf = 0;
   std::uint32_t flush_every = 8;  // queries handed to the device together
   bool learn = true;              // correct p_occl by the measured outcomes (OcclusionCalibration)
 };
@@ -173,7 +173,7 @@ class NohcCuller final : public Culler {
     std::uint32_t submission;  // QuerySubmitter tag: polled only once handed to the device
   };
 
-  bool is_leaf(NodeId n) const { return index_.bvh.is_leaf(n, config_.virtual_leaf); }
+  bool is_leaf(NodeId n) const { return index_.bvh.is_leaf(n, config_.common.virtual_leaf_triangles); }
 
   PreviousState previous_state(NodeId n) const {
     const NodeInfo& i = nodes_[n];
@@ -323,7 +323,7 @@ class NohcCuller final : public Culler {
   void handle_returned_query() {
     const Pending q = query_queue_.front();
     query_queue_.pop_front();
-    const bool visible = f_.backend->result(q.id) > config_.threshold;
+    const bool visible = f_.backend->result(q.id) > config_.common.threshold;
     calibration_.record(q.previous, q.p_occl, !visible);
     if (cancelled(q.node)) return;  // an ancestor is occluded: nothing to do
     NodeInfo& info = nodes_[q.node];
@@ -369,25 +369,46 @@ class NohcCuller final : public Culler {
 
 }  // namespace
 
-std::unique_ptr<Culler> make_nohc(const SceneIndex& index, const Options& o, const CullerContext& context) {
-  NohcConfig c;
-  c.threshold = std::uint64_t(o.get_int("nohc.threshold", 0, 0, 1 << 24));
-  c.fragments_per_pixel = o.get_double("nohc.fragments_per_pixel", c.fragments_per_pixel, 0.0, 100.0);
-  c.visible_factor = o.get_double("nohc.visible_factor", c.visible_factor, 0.0, 1.0);
-  c.levels = o.get_double("nohc.levels", c.levels, 0.0, 1000.0);
-  c.max_parallel = o.get_int("nohc.max_parallel", c.max_parallel, 0, 100000);
-  c.exact_area = o.get_bool("nohc.exact_area", c.exact_area);
-  c.virtual_leaf = std::uint32_t(o.get_int("nohc.virtual_leaf", 0, 0, 1 << 30));
-  c.flush_every = std::uint32_t(o.get_int("nohc.flush_every", int(c.flush_every), 1, 1 << 20));
-  c.learn = o.get_bool("nohc.learn", c.learn);
-  if (context.nohc_profile) return std::make_unique<NohcCuller>(index, c, *context.nohc_profile);
-  const auto it = o.values().find("nohc.profile");
-  if (it == o.values().end() || it->second.empty())
-    throw InputError("nohc needs a hardware profile: run `occull calibrate` (occull bench does it "
-                     "for you), or pass --opt nohc.profile=FILE (CullerContext::nohc_profile in a program)");
-  std::optional<HardwareProfile> profile = load_profile(it->second);
-  if (!profile) throw InputError(fmt::format("nohc.profile: '{}' does not exist", it->second));
-  return std::make_unique<NohcCuller>(index, c, std::move(*profile));
+HardwareProfile nohc_profile(const CullerContext& context, const std::string& file) {
+  if (!file.empty()) {
+    std::optional<HardwareProfile> profile = load_profile(file);
+    if (!profile) throw InputError(fmt::format("nohc.profile: '{}' does not exist", file));
+    return std::move(*profile);
+  }
+  if (context.nohc_profile) return *context.nohc_profile;
+  if (context.nohc_profile_source) return context.nohc_profile_source();
+  throw InputError("nohc needs a hardware profile: run `occull calibrate` (occull bench does it for you), or pass "
+                   "--opt nohc.profile=FILE (CullerContext::nohc_profile in a program)");
+}
+
+bool has_nohc_profile(const CullerContext& context) {
+  return context.nohc_profile != nullptr || bool(context.nohc_profile_source);
+}
+
+Registration nohc_registration() {
+  using C = NohcConfig;
+  static const ConfigTable<C> table =
+      with_common_options(ConfigTable<C>(), &C::common)
+          .text("profile", &C::profile, "hardware profile JSON; occull bench calibrates and caches one per renderer",
+                "(calibrated)")
+          .real("fragments_per_pixel", &C::fragments_per_pixel, 0.0, 100.0,
+                "overdraw assumed when estimating shaded fragments")
+          .real("visible_factor", &C::visible_factor, 0.0, 1.0,
+                "p_occl = factor * p_cov^2 for nodes visible in the last frame")
+          .real("levels", &C::levels, 0.0, 1000.0, "levels the benefit is spread over (0: log2(N_h + 1))")
+          .integer("max_parallel", &C::max_parallel, 0, 100000,
+                   "N_q: queries in flight before the oldest counts as finished (0: from the profile)")
+          .flag("exact_area", &C::exact_area, "c_bb from the exact projected box area (off: the paper's approximation)")
+          .flag("learn", &C::learn,
+                "correct the occlusion probabilities by the share of queries that found nodes occluded, per previous "
+                "state (off: the paper's model alone)")
+          .integer("flush_every", &C::flush_every, 1, 1 << 20,
+                   "hand queries to the device this many at a time, and poll only those handed over (1: each at once)");
+  return registered(
+      {"nohc", "near optimal hierarchical culling: occlusion probability + calibrated hardware cost model (seed 001)"},
+      table, [](const SceneIndex& index, const C& c, const Options&, const CullerContext& context) {
+        return std::make_unique<NohcCuller>(index, c, nohc_profile(context, c.profile));
+      });
 }
 
 }  // namespace occull::detail

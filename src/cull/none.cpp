@@ -29,8 +29,12 @@ class NoneCuller final : public Culler {
 
 }  // namespace
 
-std::unique_ptr<Culler> make_none(const SceneIndex& index, const Options&, const CullerContext&) {
-  return std::make_unique<NoneCuller>(index);
+Registration none_registration() {
+  static const ConfigTable<NoOptions> table;
+  return registered({"none", "render every object (reference cost of no culling)", true, {}, false, SceneKind::any},
+                    table, [](const SceneIndex& index, const NoOptions&, const Options&, const CullerContext&) {
+                      return std::make_unique<NoneCuller>(index);
+                    });
 }
 
 }  // namespace occull::detail

@@ -20,14 +20,21 @@
 namespace occull::detail {
 namespace {
 
+struct PerObjectConfig {
+  std::uint32_t interval = 5;  ///< MAX_FRAMES_WO_OCCLUSION_TESTING
+  bool render_pending = true;
+  bool prepass = true;
+  std::uint64_t threshold = 0;
+};
+
 class PerObjectCuller final : public Culler {
  public:
-  PerObjectCuller(const SceneIndex& index, const Options& o)
+  PerObjectCuller(const SceneIndex& index, const PerObjectConfig& c)
       : index_(index),
-        interval_(std::uint32_t(o.get_int("perobject.interval", 5, 1, 1000))),
-        render_pending_(o.get_bool("perobject.render_pending", true)),
-        prepass_(o.get_bool("perobject.prepass", true)),
-        threshold_(std::uint64_t(o.get_int("perobject.threshold", 0, 0, 1 << 24))),
+        interval_(c.interval),
+        render_pending_(c.render_pending),
+        prepass_(c.prepass),
+        threshold_(c.threshold),
         state_(index.scene.objects().size()) {
     for (State& s : state_) s.frames_without_test = interval_;
   }
@@ -136,8 +143,23 @@ class PerObjectCuller final : public Culler {
 
 }  // namespace
 
-std::unique_ptr<Culler> make_perobject(const SceneIndex& index, const Options& options, const CullerContext&) {
-  return std::make_unique<PerObjectCuller>(index, options);
+Registration perobject_registration() {
+  static const ConfigTable<PerObjectConfig> table =
+      ConfigTable<PerObjectConfig>()
+          .integer("interval", &PerObjectConfig::interval, 1, 1000,
+                   "MAX_FRAMES_WO_OCCLUSION_TESTING: frames a visible object goes untested")
+          .flag("render_pending", &PerObjectConfig::render_pending, "draw an object while its query is pending")
+          .flag("prepass", &PerObjectConfig::prepass, "draw occluders (class always) first and never test them")
+          .integer("threshold", &PerObjectConfig::threshold, 0, 1 << 24,
+                   "an object is visible when more samples (pixels) pass")
+          .approximate_unless_default();
+  return registered({"perobject",
+                     "per-object async queries after an occluder pre-pass; visible objects re-tested every N frames "
+                     "(seed 002)",
+                     false},
+                    table, [](const SceneIndex& index, const PerObjectConfig& c, const Options&, const CullerContext&) {
+                      return std::make_unique<PerObjectCuller>(index, c);
+                    });
 }
 
 }  // namespace occull::detail

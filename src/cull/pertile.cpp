@@ -14,9 +14,8 @@ namespace {
 
 class PerTileCuller final : public Culler {
  public:
-  PerTileCuller(const SceneIndex& index, const Options& o)
-      : world_(tiled_world(index, "pertile")),
-        cache_(index, "chcpp", o, o.get_int("pertile.evict", 60, 1, 1000000)) {}
+  PerTileCuller(const SceneIndex& index, const TileCacheConfig& c, const Options& o)
+      : world_(tiled_world(index, "pertile")), cache_(index, "chcpp", o, c.evict) {}
 
   FrameStats cull(const View& view, Backend& backend) override {
     FrameStats stats;
@@ -37,8 +36,17 @@ class PerTileCuller final : public Culler {
 
 }  // namespace
 
-std::unique_ptr<Culler> make_pertile(const SceneIndex& index, const Options& options, const CullerContext&) {
-  return std::make_unique<PerTileCuller>(index, options);
+Registration pertile_registration() {
+  static const ConfigTable<TileCacheConfig> table = ConfigTable<TileCacheConfig>().integer(
+      "evict", &TileCacheConfig::evict, 1, 1000000,
+      "frames a tile instance may go unused before its BVH instance and CHC++ context are freed");
+  return registered({"pertile",
+                     "tiled worlds: every tile instance in the frustum culled by its own CHC++ context, nearest first, "
+                     "no tile queries (seed 004)",
+                     true, {}, false, SceneKind::tiled},
+                    table, [](const SceneIndex& index, const TileCacheConfig& c, const Options& o, const CullerContext&) {
+                      return std::make_unique<PerTileCuller>(index, c, o);
+                    });
 }
 
 }  // namespace occull::detail

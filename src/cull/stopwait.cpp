@@ -11,8 +11,7 @@ namespace {
 
 class StopWaitCuller final : public Culler {
  public:
-  StopWaitCuller(const SceneIndex& index, const Options& options)
-      : index_(index), common_(read_common_options(options, "stopwait")) {}
+  StopWaitCuller(const SceneIndex& index, const CommonOptions& common) : index_(index), common_(common) {}
 
   FrameStats cull(const View& view, Backend& backend) override {
     FrameStats stats;
@@ -54,8 +53,14 @@ class StopWaitCuller final : public Culler {
 
 }  // namespace
 
-std::unique_ptr<Culler> make_stopwait(const SceneIndex& index, const Options& options, const CullerContext&) {
-  return std::make_unique<StopWaitCuller>(index, options);
+Registration stopwait_registration() {
+  static const ConfigTable<CommonOptions> table =
+      with_common_options(ConfigTable<CommonOptions>(), [](auto& c) -> auto& { return c; });
+  return registered(
+      {"stopwait", "hierarchical stop-and-wait: query every node in the frustum front to back, wait for each"},
+      table, [](const SceneIndex& index, const CommonOptions& c, const Options&, const CullerContext&) {
+        return std::make_unique<StopWaitCuller>(index, c);
+      });
 }
 
 }  // namespace occull::detail

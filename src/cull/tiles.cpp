@@ -35,15 +35,22 @@
 namespace occull::detail {
 namespace {
 
+struct TilesConfig {
+  std::string local = "chcpp";  // culler inside a visible tile (empty: draw the whole tile)
+  int evict = 60;
+  int neighbors = 8;
+  std::uint32_t requery = 1;
+  bool common_box = true;
+};
+
 class TilesCuller final : public Culler {
  public:
-  TilesCuller(const SceneIndex& index, const Options& o)
+  TilesCuller(const SceneIndex& index, const TilesConfig& c, const Options& o)
       : world_(tiled_world(index, "tiles")),
-        cache_(index, o.get_choice("tiles.local", "chcpp", {"chcpp", "none"}) == "chcpp" ? "chcpp" : "", o,
-               o.get_int("tiles.evict", 60, 1, 1000000)),
-        neighbors_(o.get_choice("tiles.neighbors", "8", {"4", "8"}) == "8" ? 8 : 4),
-        common_box_(o.get_choice("tiles.box", "common", {"common", "tile"}) == "common"),
-        requery_(std::uint64_t(o.get_int("tiles.requery", 1, 1, 1000))) {}
+        cache_(index, c.local, o, c.evict),
+        neighbors_(c.neighbors),
+        common_box_(c.common_box),
+        requery_(c.requery) {}
 
   FrameStats cull(const View& view, Backend& backend) override {
     FrameStats stats;
@@ -192,8 +199,30 @@ class TilesCuller final : public Culler {
 
 }  // namespace
 
-std::unique_ptr<Culler> make_tiles(const SceneIndex& index, const Options& options, const CullerContext&) {
-  return std::make_unique<TilesCuller>(index, options);
+Registration tiles_registration() {
+  using C = TilesConfig;
+  static const ConfigTable<C> table =
+      ConfigTable<C>()
+          .choice("local", &C::local, std::vector<std::pair<std::string, std::string>>{{"chcpp", "chcpp"}, {"none", ""}},
+                  "culling inside a visible tile: chcpp (its own CHC++ context) or none (draw the whole tile)")
+          .integer("evict", &C::evict, 1, 1000000,
+                   "frames a tile instance may go unused before its BVH instance and CHC++ context are freed")
+          .choice("neighbors", &C::neighbors, {{"4", 4}, {"8", 8}},
+                  "neighbours a visible tile queries: 4 (edges) or 8 (edges and corners)")
+          .integer("requery", &C::requery, 1, 1000,
+                   "a tile found visible is queried again every N frames and drawn without a query in between (1: "
+                   "every frame, as the paper; N > 1 as CHC++ re-queries visible nodes)")
+          .choice("box", &C::common_box, {{"common", true}, {"tile", false}},
+                  "box a tile query draws: common (the union of every tile's box) or tile (the queried tile's own box: "
+                  "not conservative, seed 004's Figure 7, kept to show why)")
+          .approximate_unless_default();
+  return registered({"tiles",
+                     "tiled worlds: visibility propagated tile to tile by queries of the common box, front to back, "
+                     "with temporal prediction; each visible tile culled by its own CHC++ (seed 004, Algorithms 1-4)",
+                     true, {}, false, SceneKind::tiled},
+                    table, [](const SceneIndex& index, const C& c, const Options& o, const CullerContext&) {
+                      return std::make_unique<TilesCuller>(index, c, o);
+                    });
 }
 
 }  // namespace occull::detail

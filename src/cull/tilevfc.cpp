@@ -13,9 +13,8 @@ namespace {
 
 class TileVfcCuller final : public Culler {
  public:
-  TileVfcCuller(const SceneIndex& index, const Options& o)
-      : index_(index), world_(tiled_world(index, "tilevfc")),
-        cache_(index, "", o, o.get_int("tilevfc.evict", 60, 1, 1000000)) {}
+  TileVfcCuller(const SceneIndex& index, const TileCacheConfig& c, const Options& o)
+      : index_(index), world_(tiled_world(index, "tilevfc")), cache_(index, "", o, c.evict) {}
 
   FrameStats cull(const View& view, Backend& backend) override {
     FrameStats stats;
@@ -45,8 +44,17 @@ class TileVfcCuller final : public Culler {
 
 }  // namespace
 
-std::unique_ptr<Culler> make_tilevfc(const SceneIndex& index, const Options& options, const CullerContext&) {
-  return std::make_unique<TileVfcCuller>(index, options);
+Registration tilevfc_registration() {
+  static const ConfigTable<TileCacheConfig> table = ConfigTable<TileCacheConfig>().integer(
+      "evict", &TileCacheConfig::evict, 1, 1000000,
+      "frames a tile instance may go unused before its BVH instance is freed");
+  return registered({"tilevfc",
+                     "tiled worlds: view-frustum culling over the BVH of every tile instance in the frustum, nearest "
+                     "tile first (seed 004's baseline)",
+                     true, {}, false, SceneKind::tiled},
+                    table, [](const SceneIndex& index, const TileCacheConfig& c, const Options& o, const CullerContext&) {
+                      return std::make_unique<TileVfcCuller>(index, c, o);
+                    });
 }
 
 }  // namespace occull::detail

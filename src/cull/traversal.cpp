@@ -45,13 +45,4 @@ void collect_in_frustum_front_to_back(const SceneIndex& index, const View& view,
   collect(index, Bvh::root(), Frustum::all_planes, view, out, stats);
 }
 
-CommonOptions read_common_options(const Options& options, const std::string& algo,
-                                  std::uint32_t default_virtual_leaf) {
-  CommonOptions c;
-  c.threshold = std::uint64_t(options.get_int(algo + ".threshold", 0, 0, 1 << 24));
-  c.virtual_leaf_triangles = std::uint32_t(
-      options.get_int(algo + ".virtual_leaf", int(default_virtual_leaf), 0, 1 << 30));
-  return c;
-}
-
 }  // namespace occull::detail

@@ -4,6 +4,7 @@
 #pragma once
 
 #include "occull/bvh.hpp"
+#include "config_table.hpp"
 #include "occull/culler.hpp"
 
 #include <array>
@@ -247,12 +248,21 @@ inline void append_query_boxes(const SceneIndex& index, NodeId n, const QuerySha
     out.push_back(index.bvh.node(n).bounds);
 }
 
-/// Options every hierarchical query culler shares, read from "<algo>.key".
+/// Options every hierarchical query culler shares.
 struct CommonOptions {
   std::uint64_t threshold = 0;           ///< a node is visible when more samples pass
   std::uint32_t virtual_leaf_triangles = 0;
 };
-CommonOptions read_common_options(const Options& options, const std::string& algo,
-                                  std::uint32_t default_virtual_leaf = 0);
+
+/// Adds the fields of the CommonOptions at `at` (see ConfigTable) to `table`.
+template <class Config, class At>
+ConfigTable<Config>&& with_common_options(ConfigTable<Config>&& table, At at) {
+  return std::move(table)
+      .integer("threshold", [at](auto& c) -> auto& { return std::invoke(at, c).threshold; }, 0, 1 << 24,
+               "a node is visible when more samples (pixels) pass")
+      .approximate_unless_default()
+      .integer("virtual_leaf", [at](auto& c) -> auto& { return std::invoke(at, c).virtual_leaf_triangles; }, 0,
+               1 << 30, "subtrees with at most this many triangles count as leaves (0: off)");
+}
 
 }  // namespace occull::detail

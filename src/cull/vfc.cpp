@@ -29,8 +29,12 @@ class VfcCuller final : public Culler {
 
 }  // namespace
 
-std::unique_ptr<Culler> make_vfc(const SceneIndex& index, const Options&, const CullerContext&) {
-  return std::make_unique<VfcCuller>(index);
+Registration vfc_registration() {
+  static const ConfigTable<NoOptions> table;
+  return registered({"vfc", "hierarchical view-frustum culling over the BVH, front to back"}, table,
+                    [](const SceneIndex& index, const NoOptions&, const Options&, const CullerContext&) {
+                      return std::make_unique<VfcCuller>(index);
+                    });
 }
 
 }  // namespace occull::detail

@@ -26,15 +26,6 @@
 namespace occull {
 namespace {
 
-// Whether a run of `spec` uses NOHC's hardware profile: nohc itself, and
-// auto unless its candidates leave nohc out.
-bool needs_profile(const AlgorithmSpec& spec) {
-  if (spec.name == "nohc") return true;
-  if (spec.name != "auto") return false;
-  const auto it = spec.options.values().find("auto.candidates");
-  return it == spec.options.values().end() || it->second.find("nohc") != std::string::npos;
-}
-
 using Clock = std::chrono::steady_clock;
 
 double ms_between(Clock::time_point a, Clock::time_point b) {
@@ -321,11 +312,12 @@ FrameTruth Session::truth_of(const View& view, const detail::FrameLabel& where) 
   return t;
 }
 
-std::unique_ptr<Culler> Session::make(std::string_view spec, const Options& options) {
+std::unique_ptr<Culler> Session::make(std::string_view spec, const Options& options,
+                                      const std::function<void(const std::string&)>& progress) {
   const AlgorithmSpec a = parse_algorithm_spec(spec, options);
   if (a.name == "oracle") return std::make_unique<detail::OracleCuller>(bundle_.scene);
   CullerContext context;  // nohc: the calibrated profile, unless an option names a file
-  if (needs_profile(a) && !a.options.has("nohc.profile")) context.nohc_profile = &hardware_profile();
+  context.nohc_profile_source = [&]() -> const HardwareProfile& { return hardware_profile(progress); };
   return make_culler(a.name, index(), a.options, context);
 }
 
@@ -803,24 +795,17 @@ BenchResult run_bench(const BenchConfig& config, const ProgressFn& progress) {
           "--frames {} at --fps {} from --start {} s runs past the end of path {} ({:.1f} s): {} frames fit",
           config.frames, config.sampling.fps, config.sampling.start_s, p->name(), p->duration(), fit));
   const CameraPath& path = *paths.front();
-  bool uses_profile = config.model;
-  std::string profile_path;
-  for (const auto& n : names) {
-    const AlgorithmSpec spec = parse_algorithm_spec(n, config.options);
-    if (!needs_profile(spec)) continue;
-    if (spec.options.has("nohc.profile"))
+  // Each culler made once early: its options checked, and the hardware
+  // profile calibrated (first use on this renderer: seconds) if one needs it.
+  const auto say = [&](const std::string& line) {
+    if (progress) progress(line, 0, 0, false);
+  };
+  if (config.model) (void)session.hardware_profile(say);
+  for (const auto& n : names) (void)session.make(n, config.options, say);
+  std::string profile_path = session.has_hardware_profile() ? session.hardware_profile_path() : "";
+  for (const auto& n : names)
+    if (const AlgorithmSpec spec = parse_algorithm_spec(n, config.options); spec.options.has("nohc.profile"))
       profile_path = spec.options.values().at("nohc.profile");
-    else
-      uses_profile = true;
-  }
-  // First use on this renderer calibrates (seconds): say so.
-  if (uses_profile) {
-    (void)session.hardware_profile([&](const std::string& line) {
-      if (progress) progress(line, 0, 0, false);
-    });
-    profile_path = session.hardware_profile_path();
-  }
-  for (const auto& n : names) (void)session.make(n, config.options);  // options of each, early
 
   BenchResult result;
   result.device = session.device();

@@ -1,0 +1,188 @@
+// Internal: an algorithm's options written once. Each algorithm keeps a
+// typed config struct whose member initialisers are its defaults, and one
+// table of its fields (key, member, range, help). The table is the parser
+// (Options -> config), the registry entry (AlgorithmInfo::options, with each
+// default read from a default-constructed config) and the test of whether a
+// run's options make it approximate. Nothing else names an option's key,
+// range or default.
+#pragma once
+
+#include "occull/culler.hpp"
+#include "occull/error.hpp"
+
+#include <fmt/format.h>
+
+#include <functional>
+#include <type_traits>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace occull::detail {
+
+template <class Config>
+class ConfigTable {
+ public:
+  // `at` names the field: a member pointer (&Config::batch) or, for members
+  // of nested structs, a generic lambda [](auto& c) -> auto& { ... } (it is
+  // called on const configs too).
+
+  /// A whole number in [lo, hi].
+  template <class At>
+  ConfigTable&& integer(std::string key, At at, int lo, int hi, std::string help) && {
+    add(std::move(key), std::move(help), fmt::format("[{}, {}]", lo, hi),
+        [at, lo, hi](Config& c, const Options& o, const std::string& k) {
+          auto& m = std::invoke(at, c);
+          m = static_cast<std::remove_reference_t<decltype(m)>>(o.get_int(k, int(m), lo, hi));
+        },
+        [at](const Config& c) { return fmt::format("{}", std::invoke(at, c)); });
+    return std::move(*this);
+  }
+  /// A finite number in [lo, hi].
+  template <class At>
+  ConfigTable&& real(std::string key, At at, double lo, double hi, std::string help) && {
+    add(std::move(key), std::move(help), fmt::format("[{}, {}]", lo, hi),
+        [at, lo, hi](Config& c, const Options& o, const std::string& k) {
+          auto& m = std::invoke(at, c);
+          m = static_cast<std::remove_reference_t<decltype(m)>>(o.get_double(k, double(m), lo, hi));
+        },
+        [at](const Config& c) { return fmt::format("{}", std::invoke(at, c)); });
+    return std::move(*this);
+  }
+  /// on/off (also true/false, yes/no, 1/0).
+  template <class At>
+  ConfigTable&& flag(std::string key, At at, std::string help) && {
+    add(std::move(key), std::move(help), "on|off",
+        [at](Config& c, const Options& o, const std::string& k) {
+          bool& m = std::invoke(at, c);
+          m = o.get_bool(k, m);
+        },
+        [at](const Config& c) -> std::string { return std::invoke(at, c) ? "on" : "off"; });
+    return std::move(*this);
+  }
+  /// One of the named values.
+  template <class At>
+  ConfigTable&& choice(std::string key, At at,
+                       std::vector<std::pair<std::string, std::remove_cvref_t<std::invoke_result_t<At, Config&>>>> names,
+                       std::string help) && {
+    std::string values;
+    for (const auto& n : names) values += (values.empty() ? "" : "|") + n.first;
+    add(std::move(key), std::move(help), std::move(values),
+        [at, names](Config& c, const Options& o, const std::string& k) {
+          const auto it = o.values().find(k);
+          if (it == o.values().end()) return;
+          std::string valid;
+          for (const auto& [name, value] : names) {
+            if (name == it->second) {
+              std::invoke(at, c) = value;
+              return;
+            }
+            valid += (valid.empty() ? "" : ", ") + name;
+          }
+          throw InputError(fmt::format("option {}: '{}' is not one of {}", k, it->second, valid));
+        },
+        [at, names](const Config& c) -> std::string {
+          for (const auto& [name, value] : names)
+            if (value == std::invoke(at, c)) return name;
+          return "?";
+        });
+    return std::move(*this);
+  }
+  /// Free text; `when_empty` is how the help shows an empty default.
+  template <class At>
+  ConfigTable&& text(std::string key, At at, std::string help, std::string when_empty = "") && {
+    add(std::move(key), std::move(help), "",
+        [at](Config& c, const Options& o, const std::string& k) {
+          const auto it = o.values().find(k);
+          if (it != o.values().end()) std::invoke(at, c) = it->second;
+        },
+        [at, when_empty](const Config& c) -> std::string {
+          const std::string& v = std::invoke(at, c);
+          return v.empty() ? when_empty : v;
+        });
+    return std::move(*this);
+  }
+  /// Marks the field added last: any value but its default may cull visible
+  /// objects (OptionInfo::approximate_unless_default).
+  ConfigTable&& approximate_unless_default() && {
+    fields_.back().info.approximate_unless_default = true;
+    return std::move(*this);
+  }
+
+  /// The config `options` ("algo.key" -> value) give `algo`: defaults where
+  /// a key is absent. Throws InputError naming a value that does not parse
+  /// or lies outside its range. Keys of other algorithms are ignored.
+  [[nodiscard]] Config parse(const Options& options, std::string_view algo) const {
+    Config c;
+    for (const Field& f : fields_) f.read(c, options, fmt::format("{}.{}", algo, f.info.key));
+    return c;
+  }
+  /// The registry's description of every field, defaults from Config{}.
+  [[nodiscard]] std::vector<OptionInfo> describe() const {
+    const Config defaults{};
+    std::vector<OptionInfo> out;
+    for (const Field& f : fields_) {
+      OptionInfo info = f.info;
+      info.default_value = f.show(defaults);
+      out.push_back(std::move(info));
+    }
+    return out;
+  }
+  /// Whether `options` set a field marked approximate_unless_default to a
+  /// value other than its default (compared parsed, so "00" is 0).
+  [[nodiscard]] bool approximate(const Options& options, std::string_view algo) const {
+    const Config c = parse(options, algo);
+    const Config defaults{};
+    for (const Field& f : fields_)
+      if (f.info.approximate_unless_default && f.show(c) != f.show(defaults)) return true;
+    return false;
+  }
+
+ private:
+  struct Field {
+    OptionInfo info;
+    std::function<void(Config&, const Options&, const std::string&)> read;
+    std::function<std::string(const Config&)> show;
+  };
+  template <class Read, class Show>
+  void add(std::string key, std::string help, std::string values, Read read, Show show) {
+    OptionInfo info;
+    info.key = std::move(key);
+    info.values = std::move(values);
+    info.help = std::move(help);
+    fields_.push_back(Field{std::move(info), std::move(read), std::move(show)});
+  }
+  std::vector<Field> fields_;
+};
+
+/// The config of an algorithm without options.
+struct NoOptions {};
+
+/// How the registry makes an algorithm from options (null: harness only).
+using Factory = std::function<std::unique_ptr<Culler>(const SceneIndex&, const Options&, const CullerContext&)>;
+
+/// An algorithm as the registry holds it.
+struct Registration {
+  AlgorithmInfo info;
+  Factory make;
+  /// Whether options make a run approximate (null: never).
+  std::function<bool(const Options&)> approximate;
+};
+
+/// The registration of an algorithm with a config table: its options are
+/// the table's fields, and `make(index, config, options, context)` gets the
+/// parsed config (and the whole options, for algorithms that make others).
+/// `table` must outlive the registry (a function-local static).
+template <class Config, class Make>
+Registration registered(AlgorithmInfo info, const ConfigTable<Config>& table, Make make) {
+  info.options = table.describe();
+  const std::string name = info.name;
+  Registration r{std::move(info), {}, {}};
+  r.make = [&table, name, make](const SceneIndex& index, const Options& o, const CullerContext& context) {
+    return make(index, table.parse(o, name), o, context);
+  };
+  r.approximate = [&table, name](const Options& o) { return table.approximate(o, name); };
+  return r;
+}
+
+}  // namespace occull::detail
