@@ -119,6 +119,10 @@ class ChcppCuller final : public Culler {
     seen_.begin(index_.scene);
     if (seen_.rebuilt(index_.bvh)) {
       carry_over(state_, index_.bvh, seen_, frame_ - 1);
+      // A leaf carried over visible was drawn last frame: its next query
+      // comes as a newly visible leaf's would, not all at once now.
+      for (NodeState& s : state_)
+        if (s.visible) s.next_query = frame_ + requery_delay();
       gate_ = EnteringGate(reset_nodes(), config_.enter_p_min);
     }
     f_.begin(view, backend);

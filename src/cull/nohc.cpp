@@ -98,15 +98,18 @@ class NohcCuller final : public Culler {
   NohcCuller(const SceneIndex& index, const NohcConfig& config, HardwareProfile profile)
       : index_(index), config_(config), hw_(std::move(profile)), nodes_(index.bvh.size()),
         submitter_(config.flush_every) {
+    (void)seen_.rebuilt(index.bvh);
     describe_nodes();
     max_parallel_ = config.max_parallel > 0 ? config.max_parallel : std::max(1, hw_.max_parallel_queries());
   }
 
   FrameStats cull(const View& view, Backend& backend) override {
     ++frame_;
-    // A rebuilt hierarchy starts over (conservative: only queries cull); a
-    // changed set of objects changes the nodes' areas and shading.
-    const bool rebuilt = generation_ != index_.bvh.generation();
+    // A rebuilt hierarchy starts from what was drawn last frame (carry_over;
+    // conservative whatever it says: only queries cull); a changed set of
+    // objects changes the nodes' areas and shading.
+    seen_.begin(index_.scene);
+    const bool rebuilt = seen_.rebuilt(index_.bvh);
     if (rebuilt || layout_ != index_.scene.layout_revision()) describe_nodes(rebuilt);
     f_.begin(view, backend);
     frustum_.begin(index_.bvh, view);
@@ -133,10 +136,11 @@ class NohcCuller final : public Culler {
 
  private:
   // Per node: triangle-weighted shading cost and object surface area (and,
-  // with `forget`, a fresh temporal state).
-  void describe_nodes(bool forget = true) {
+  // with `rebuilt`, the temporal state carried over from the objects drawn
+  // last frame).
+  void describe_nodes(bool rebuilt = true) {
     const Bvh& bvh = index_.bvh;
-    if (forget || nodes_.size() != bvh.size()) nodes_.assign(bvh.size(), NodeInfo{});
+    if (rebuilt || nodes_.size() != bvh.size()) carry_over(nodes_, bvh, seen_, frame_ - 1);
     for (NodeId n = NodeId(bvh.size()); n-- > 0;) {
       NodeInfo& info = nodes_[n];
       double weighted = 0.0;
@@ -149,7 +153,6 @@ class NohcCuller final : public Culler {
       info.shading = bvh.node(n).triangles > 0 ? weighted / double(bvh.node(n).triangles) : 0.0;
     }
     levels_ = config_.levels > 0.0 ? config_.levels : std::log2(double(bvh.size()) + 1.0);
-    generation_ = bvh.generation();
     layout_ = index_.scene.layout_revision();
   }
 
@@ -340,6 +343,7 @@ class NohcCuller final : public Culler {
   void flush_render_queue() {
     if (render_queue_.empty()) return;
     f_.backend->render(render_queue_);
+    seen_.drawn(render_queue_, frame_);
     render_queue_.clear();
   }
 
@@ -354,7 +358,7 @@ class NohcCuller final : public Culler {
   // Per frame.
   FrameContext f_;
   FrustumCache frustum_;
-  std::uint64_t generation_ = 0;  // Bvh::generation() of nodes_
+  ObjectVisibility seen_;  // what was drawn, for nodes_ after a rebuild of the hierarchy
   std::uint64_t layout_ = 0;      // Scene::layout_revision() of nodes_
   double c_scr_ = 0.0;
   double model_p_occl_ = 0.0;  // the model's p_occl of the last estimate, before calibration

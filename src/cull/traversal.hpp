@@ -31,7 +31,9 @@ inline bool was_visible(const NodeState& s, std::uint32_t frame) {
 
 /// Marks `n` and its ancestors visible, stopping at the first ancestor that
 /// already is (CHC's PullUpVisibility).
-inline void pull_up_visibility(std::vector<NodeState>& state, const Bvh& bvh, NodeId n) {
+/// `Node`: NodeState, or any per-node record with a `visible` flag.
+template <class Node>
+void pull_up_visibility(std::vector<Node>& state, const Bvh& bvh, NodeId n) {
   while (n != kNoNode && !state[n].visible) {
     state[n].visible = true;
     n = bvh.node(n).parent;
@@ -104,10 +106,10 @@ class ObjectVisibility {
 /// so were its ancestors; every node counts as visited in `frame`, so the
 /// others are queried as CHC queries the previously invisible. Conservative
 /// whatever `seen` says: only queries cull.
-inline void carry_over(std::vector<NodeState>& state, const Bvh& bvh, const ObjectVisibility& seen,
-                       std::uint32_t frame) {
-  state.assign(bvh.size(), NodeState{});
-  for (NodeState& s : state) s.last_visited = frame;
+template <class Node>  // NodeState, or a record with `visible` and `last_visited`
+void carry_over(std::vector<Node>& state, const Bvh& bvh, const ObjectVisibility& seen, std::uint32_t frame) {
+  state.assign(bvh.size(), Node{});
+  for (Node& s : state) s.last_visited = frame;
   for (NodeId n = 0; n < NodeId(bvh.size()); ++n) {
     if (!bvh.node(n).is_leaf()) continue;
     for (ObjectId id : bvh.objects(n))
