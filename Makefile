@@ -10,7 +10,9 @@ CMAKE_FLAGS ?=
 
 .PHONY: demo test test-asan fuzz fuzz-regress fuzz-build deps data configure build install clean gpu-pack
 
-demo: build
+# The demo builds the tool alone (not the tests a newcomer did not ask for).
+demo: configure
+	cmake --build $(BUILD) -j $(JOBS) --target occull_cli
 	./$(BUILD)/occull bench
 
 test: build data

@@ -16,7 +16,7 @@ packages=(
   # occull view: a window (GLFW) with Dear ImGui; tested under a virtual X server
   libglfw3-dev libimgui-dev xvfb xauth
   # tests and benchmarks
-  libgtest-dev libgmock-dev libbenchmark-dev
+  libgtest-dev libgmock-dev
 )
 # --fuzz: also what make fuzz needs (clang and its libFuzzer runtime).
 if [[ "${1:-}" == "--fuzz" ]]; then

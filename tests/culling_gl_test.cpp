@@ -65,7 +65,7 @@ TEST(ConservativeCullers, MissNothingWhenTheCameraPassesThroughObjects) {
   expect_no_misses(session, through, "a path through buildings");
 }
 
-// Seed 004's cullers on each tiling set and path (frames spread over each
+// Gomez et al.'s cullers on each tiling set and path (frames spread over each
 // path: walk10k's 10 km, the grazing flight), with both neighbourhoods.
 TEST(ConservativeCullers, MissNothingOnTiledWorlds) {
   const char* const kTiled[] = {"tilevfc", "pertile", "tiles", "tiles:local=none", "tiles:neighbors=4", "tiles:requery=4"};
@@ -83,7 +83,7 @@ TEST(ConservativeCullers, MissNothingOnTiledWorlds) {
   }
 }
 
-// The verifier catches what seed 004's Figure 7 warns of: tile queries over
+// The verifier catches what Gomez et al. 2013's Figure 7 warns of: tile queries over
 // each tile's own box stop propagation at a low tile and lose the tall ones
 // seen over it. Over the same frames the common box misses nothing.
 TEST(ConservativeCullers, TileQueriesOverTheTilesOwnBoxesAreCaughtMissing) {

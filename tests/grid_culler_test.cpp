@@ -1,4 +1,4 @@
-// `grid` (seed 003's uniform-grid culling) against a Backend test double
+// `grid` (Seletsky 2013's uniform-grid culling) against a Backend test double
 // whose answers the test controls.
 #include "occull/culler.hpp"
 #include "occull/error.hpp"

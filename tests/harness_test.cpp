@@ -68,11 +68,11 @@ std::optional<ObjectId> always_visible(const std::vector<FrameTruth>& truth) {
   return std::nullopt;
 }
 
-// The names in the README's "JSON output" block (every "quoted" word).
+// The names in docs/instrument.md's "JSON output" block (every "quoted" word).
 std::set<std::string> readme_json_names() {
-  std::ifstream in(std::string(OCCULL_SOURCE_DIR) + "/README.md");
+  std::ifstream in(std::string(OCCULL_SOURCE_DIR) + "/docs/instrument.md");
   const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  const auto heading = text.find("### JSON output");
+  const auto heading = text.find("## JSON output");
   const auto open = text.find("```", heading);
   const auto close = text.find("```", open + 3);
   std::set<std::string> names;

@@ -1,4 +1,4 @@
-// perobject (seed 002's per-object asynchronous queries) against a Backend
+// perobject (the engine notes' per-object asynchronous queries) against a Backend
 // test double whose answers and their timing the test controls.
 #include "occull/culler.hpp"
 #include "test_util.hpp"

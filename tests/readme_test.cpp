@@ -1,9 +1,11 @@
-// The README's integration section quotes the example engine, which is
+// The library guide (docs/library.md) quotes the example engine, which is
 // compiled and run by the tests: every region of examples/engine/main.cpp
-// between "// [readme: NAME]" and "// [readme end]" must appear in README.md
-// as it stands (less the region's common indentation), so neither can drift.
+// between "// [readme: NAME]" and "// [readme end]" must appear in it as it
+// stands (less the region's common indentation), and every C++ block of
+// README.md must be one of those regions, so none of them can drift.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <fstream>
 #include <sstream>
 #include <string>
@@ -55,13 +57,24 @@ std::vector<Region> regions_of(const std::string& source) {
 
 TEST(Readme, QuotesTheExampleEngineAsItStands) {
   const std::string source = read(std::string(OCCULL_SOURCE_DIR) + "/examples/engine/main.cpp");
-  const std::string readme = read(std::string(OCCULL_SOURCE_DIR) + "/README.md");
+  const std::string guide = read(std::string(OCCULL_SOURCE_DIR) + "/docs/library.md");
   const std::vector<Region> regions = regions_of(source);
   ASSERT_GE(regions.size(), 4u) << "examples/engine/main.cpp lost its [readme: NAME] regions";
   for (const Region& r : regions) {
     ASSERT_FALSE(r.body.empty()) << r.name;
-    EXPECT_NE(readme.find(r.body), std::string::npos)
-        << "README.md does not quote the example engine's region '" << r.name << "' as it stands:\n"
+    EXPECT_NE(guide.find(r.body), std::string::npos)
+        << "docs/library.md does not quote the example engine's region '" << r.name << "' as it stands:\n"
         << r.body;
   }
+  const std::string readme = read(std::string(OCCULL_SOURCE_DIR) + "/README.md");
+  std::size_t blocks = 0;
+  for (std::size_t at = readme.find("```cpp\n"); at != std::string::npos; at = readme.find("```cpp\n", at)) {
+    at += 7;
+    const std::string block = readme.substr(at, readme.find("```", at) - at);
+    ++blocks;
+    EXPECT_TRUE(std::any_of(regions.begin(), regions.end(), [&](const Region& r) { return r.body == block; }))
+        << "README.md quotes C++ that is no region of the example engine:\n"
+        << block;
+  }
+  EXPECT_GT(blocks, 0u) << "README.md quotes the example engine";
 }

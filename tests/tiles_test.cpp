@@ -1,4 +1,4 @@
-// Tiled worlds (seed 004): the tile function, the window of object ids, BVH
+// Tiled worlds (Gomez et al. 2013): the tile function, the window of object ids, BVH
 // instances, and the cullers tilevfc, pertile and tiles over a Backend test
 // double. The GL check that they miss nothing is in culling_gl_test.cpp.
 #include "occull/culler.hpp"

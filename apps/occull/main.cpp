@@ -1,12 +1,8 @@
 // occull — command-line tool: device info, scenes, algorithms, benchmarks
 // and screenshots.
 //
-// Exit codes: 0 success; 1 unexpected internal error (also a violated
-// run-time invariant of the instrument); 2 bad input (unknown name, invalid
-// number, bad option, corrupt file); 3 no usable OpenGL 4.5 (EGL or driver
-// missing; view: no display or no viewer built); 4 bench: a conservative algorithm missed a visible object (the
-// table and report are written first); 5 soak: memory or the query pool
-// grew (the table and JSON are written first).
+// Exit codes: kExitCodes below (printed by --help; the README's table is
+// tested equal to it).
 #include "occull/culler.hpp"
 #include "occull/debug_view.hpp"
 #include "occull/error.hpp"
@@ -39,6 +35,7 @@
 #include <fstream>
 #include <iostream>
 #include <memory>
+#include <utility>
 #include <random>
 #include <unistd.h>
 
@@ -827,11 +824,30 @@ int cmd_upkeep(const UpkeepArgs& a) {
 
 }  // namespace
 
+namespace {
+
+// The exit codes, as --help prints them and the README's table lists them.
+constexpr std::pair<int, const char*> kExitCodes[] = {
+    {0, "success"},
+    {1, "internal error (a bug: please report it with the message), including a violated run-time invariant of the instrument, with `--gl-debug` a failing OpenGL call, and a frame past the `--watchdog` time"},
+    {2, "bad input: unknown scene / path / algorithm / option (the message lists the valid ones), invalid number or size, a damaged level, model, path or profile file (the message names the file and the fault), an output file or folder that cannot be written"},
+    {3, "no usable OpenGL 4.5: EGL or the driver is missing (the message says which package); `view`: no display, or built without its viewer"},
+    {4, "`bench`: verification failed — a conservative algorithm culled a visible object (the table, JSON and report are written first)"},
+    {5, "`soak`: resident memory or the query pool grew more than 5 % from the first window to the last (the table and JSON are written first)"},
+};
+
+std::string exit_code_table() {
+  std::string out = "Exit codes:\n";
+  for (const auto& [code, meaning] : kExitCodes) out += fmt::format("  {}  {}\n", code, meaning);
+  return out;
+}
+
+}  // namespace
+
 int main(int argc, char** argv) {
   CLI::App app{"occull — occlusion culling with hardware occlusion queries, and the instrument "
-               "that measures it.\n\nExit codes: 0 success, 1 internal error (or a violated invariant of the "
-               "instrument), 2 bad input, 3 no usable OpenGL 4.5 (view: no display), 4 a conservative algorithm missed a "
-               "visible object (bench), 5 memory or the query pool grew (soak)."};
+               "that measures it."};
+  app.footer(exit_code_table());
   app.require_subcommand(1);
 
   app.add_subcommand("info", "GL vendor, renderer, version, query counter bits, culling extensions");

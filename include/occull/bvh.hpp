@@ -35,7 +35,7 @@ enum class SplitMethod : std::uint8_t { sah, median };
 
 struct BvhOptions {
   /// Leaves hold at most this many objects (>= 1). The default builds one
-  /// object per leaf — the "slightly deeper hierarchy" of seed 000, where
+  /// object per leaf — the "slightly deeper hierarchy" of Bittner et al. 2009, where
   /// cullers group small subtrees into virtual leaves as they see fit.
   int max_leaf_objects = 1;
   int sah_bins = 16;            ///< centroid bins per axis for the SAH sweep (>= 2)
@@ -93,7 +93,7 @@ class Bvh {
   }
 
   /// True when traversal should stop at `n`: a real leaf, or a "virtual
-  /// leaf" (seed 000): an interior node with at most `virtual_leaf_triangles`
+  /// leaf" (Bittner et al. 2009): an interior node with at most `virtual_leaf_triangles`
   /// triangles. 0 disables virtual leaves. A traversal that stops at the
   /// first such node from the root sees exactly the topmost ones.
   [[nodiscard]] bool is_leaf(NodeId n, std::uint32_t virtual_leaf_triangles = 0) const {
@@ -101,7 +101,7 @@ class Bvh {
     return node.is_leaf() || node.triangles <= virtual_leaf_triangles;
   }
 
-  /// Tight bounding volume of node `n` (seed 000, "Tighter bounding
+  /// Tight bounding volume of node `n` (Bittner et al. 2009, "Tighter bounding
   /// volumes"): replaces the node's box by the boxes of its descendants,
   /// level by level down to `d_max` levels below `n` (objects of a real leaf
   /// count as the level below it), as long as the sum of their surface areas

@@ -1,5 +1,5 @@
 // occull — the NOHC hardware cost model and occlusion probability model
-// (Guthe, Balázs, Klein 2006; seed 001).
+// (Guthe, Balázs, Klein 2006).
 //
 // A HardwareProfile holds the characteristic times of Table 2, measured once
 // per renderer by calibration (occull calibrate, gl::calibrate). The
@@ -18,7 +18,7 @@
 
 namespace occull {
 
-/// Characteristic times of one renderer (seed 001, Table 2), milliseconds.
+/// Characteristic times of one renderer (Guthe et al. 2006, Table 2), milliseconds.
 struct HardwareProfile {
   std::string renderer;              ///< GL_RENDERER and GL_VERSION it was measured on
   int width = 0;                     ///< render-target size used for the measurement, pixels

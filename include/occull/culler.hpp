@@ -192,7 +192,7 @@ struct AlgorithmInfo {
 [[nodiscard]] bool runs_on(const AlgorithmInfo& info, bool tiled) noexcept;
 /// What `occull bench` runs when no algorithm is named: every algorithm
 /// that runs on the scene's kind, in presentation order; on a tiled world
-/// also `tiles:local=none` (seed 004's "tile query alone").
+/// also `tiles:local=none` (Gomez et al. 2013's "tile query alone").
 [[nodiscard]] std::vector<std::string> default_algorithms(bool tiled);
 /// The frustum-culling baseline the harness's "vs vfc" ratios divide by:
 /// `vfc`, or `tilevfc` on a tiled world.

@@ -1,5 +1,5 @@
 // occull — the uniform grid scene index and its occlusion-order traversal
-// (Seletsky, seed 003, chapters 2.5 and 4.2).
+// (Seletsky 2013, chapters 2.5 and 4.2).
 //
 // A UniformGrid lists every object in each cell its box touches. It sits
 // beside the BVH for engines whose scenes are not a hierarchy: it needs no

@@ -1,4 +1,4 @@
-// occull — split screen with the uniform-grid culler (Seletsky, seed 003,
+// occull — split screen with the uniform-grid culler (Seletsky 2013,
 // chapter 4.4): one `grid` culler per view, sharing one UniformGrid (the
 // scene is indexed once, dynamic objects move in it once per frame) and one
 // per-frame query cap, which a QueryBudget splits between the views. Each

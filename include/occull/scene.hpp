@@ -51,7 +51,7 @@ struct Material {
   int shading_cost = 0;      ///< >= 0
 };
 
-/// The occluder classes of Seletsky (seed 003): which objects belong in a
+/// The occluder classes of Seletsky 2013: which objects belong in a
 /// depth pre-pass. Walls and terrain `always`, large props `sometimes`,
 /// small details `never`.
 enum class OccluderClass : std::uint8_t { always, sometimes, never };

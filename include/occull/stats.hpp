@@ -35,7 +35,7 @@ struct FrameStats {
   double result_age = 0.0;       ///< mean frames since the query behind each answer used was issued
   std::uint64_t revealed = 0;    ///< hidden cells whose query found them visible and were drawn in its frame
 
-  // Tiled worlds (tilevfc, pertile, tiles; seed 004).
+  // Tiled worlds (tilevfc, pertile, tiles; Gomez et al. 2013).
   std::uint64_t tiles_rendered = 0;      ///< tile instances drawn (culled inside by their own culler, if any)
   std::uint64_t tile_queries = 0;        ///< queries of the common box at a tile (tiles)
   std::uint64_t tile_postponed = 0;      ///< tiles drawn on last frame's visibility while their query was pending (Algorithm 3)

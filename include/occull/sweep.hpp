@@ -1,7 +1,7 @@
 // occull — option sweeps: one algorithm over every combination of a few
 // option values, run as one interleaved benchmark (same frames, same
 // ground truth, one baseline), tabulated as frame time and popping per
-// setting, in the shape of Seletsky's Tables 5.x (seed 003).
+// setting, in the shape of Seletsky's Tables 5.x (Seletsky 2013).
 #pragma once
 
 #include "occull/harness.hpp"
@@ -38,7 +38,7 @@ inline constexpr std::size_t kMaxSweepSettings = 64;
 /// key repeats, or the combinations exceed kMaxSweepSettings.
 [[nodiscard]] std::vector<std::string> sweep_specs(std::string_view algorithm, std::span<const SweepAxis> axes);
 
-/// What a setting may pop and still count (seed 003's grid issue: at most
+/// What a setting may pop and still count (Seletsky 2013's grid issue: at most
 /// 0.1 % of the visible object-frames missed, no object missed for more
 /// than 3 frames in a row).
 struct PoppingLimit {

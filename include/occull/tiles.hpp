@@ -1,4 +1,4 @@
-// occull — tiled worlds of unbounded extent (Gomez et al. 2013, seed 004).
+// occull — tiled worlds of unbounded extent (Gomez et al. 2013).
 //
 // A tiling set is a few predefined tiles, each a local scene of object
 // instances in a cell of `cell_size` x `cell_size` scene units with its own

@@ -1,4 +1,4 @@
-// `chc`: coherent hierarchical culling (Bittner & Wimmer 2004; seed 000,
+// `chc`: coherent hierarchical culling (Bittner & Wimmer 2004; Bittner et al. 2009,
 // Listing 8.4.1).
 //
 // Front-to-back traversal that queries only previously invisible nodes and
@@ -144,7 +144,7 @@ Registration chc_registration() {
                    "n_av: a visible leaf is assumed visible for n_av frames, queried in frame n_av+1")
           .integer("flush_every", &ChcConfig::flush_every, 1, 1 << 20,
                    "hand queries to the device this many at a time, and poll only those handed over (1: each at once)");
-  return registered({"chc", "coherent hierarchical culling (Bittner & Wimmer 2004; seed 000 Listing 8.4.1)"}, table,
+  return registered({"chc", "coherent hierarchical culling (Bittner & Wimmer 2004; Bittner et al. 2009 Listing 8.4.1)"}, table,
                     [](const SceneIndex& index, const ChcConfig& c, const Options&, const CullerContext&) {
                       return std::make_unique<ChcCuller>(index, c);
                     });

@@ -1,4 +1,4 @@
-// `chcpp`: CHC++ (Mattausch, Bittner, Wimmer 2008; seed 000, Listing 8.4.2).
+// `chcpp`: CHC++ (Mattausch, Bittner, Wimmer 2008; Bittner et al. 2009, Listing 8.4.2).
 //
 // CHC with the game-engine-friendly changes of the article:
 //   - i-queue: previously invisible nodes are queried in batches of `batch`

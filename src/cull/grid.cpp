@@ -1,5 +1,5 @@
 // `grid`: uniform-grid occlusion culling with a per-frame query cap
-// (Seletsky, seed 003, chapter 4.3).
+// (Seletsky 2013, chapter 4.3).
 //
 // The scene lives in a UniformGrid (occull/grid.hpp), not the BVH. Each frame:
 //  1. read every cell query of the last frame (they are a frame old, so done)
@@ -348,7 +348,7 @@ const ConfigTable<GridConfig>& grid_table() {
 Registration grid_registration() {
   return registered({"grid",
                      "uniform grid in occlusion order, cell queries read a frame later, occluder pre-pass, per-frame "
-                     "query cap (Seletsky, seed 003); may pop",
+                     "query cap (Seletsky 2013); may pop",
                      false},
                     grid_table(), [](const SceneIndex& index, const GridConfig& c, const Options&, const CullerContext&) {
                       return std::make_unique<GridCuller>(

@@ -1,5 +1,5 @@
 // `nohc`: near optimal hierarchical culling (Guthe, Balázs, Klein 2006;
-// seed 001, Figures 4 and 5).
+// Guthe et al. 2006, Figures 4 and 5).
 //
 // A front-to-back traversal like CHC's, but every query is a priced
 // decision. Each node gets an occlusion probability from the screen
@@ -409,7 +409,7 @@ Registration nohc_registration() {
           .integer("flush_every", &C::flush_every, 1, 1 << 20,
                    "hand queries to the device this many at a time, and poll only those handed over (1: each at once)");
   return registered(
-      {"nohc", "near optimal hierarchical culling: occlusion probability + calibrated hardware cost model (seed 001)"},
+      {"nohc", "near optimal hierarchical culling: occlusion probability + calibrated hardware cost model (Guthe et al. 2006)"},
       table, [](const SceneIndex& index, const C& c, const Options&, const CullerContext& context) {
         return std::make_unique<NohcCuller>(index, c, nohc_profile(context, c.profile));
       });

@@ -1,5 +1,5 @@
 // Internal: the decision at the heart of NOHC — is a query for this node
-// reasonable? (seed 001, Sections 4.1–4.2, Figure 5) — as a pure function,
+// reasonable? (Guthe et al. 2006, Sections 4.1–4.2, Figure 5) — as a pure function,
 // so unit tests can walk its branches. The culler is in nohc.cpp.
 #pragma once
 

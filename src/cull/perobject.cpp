@@ -1,5 +1,5 @@
 // `perobject`: per-object asynchronous occlusion queries, after the engine
-// notes' "Simple Pseudo-code" (seed 002).
+// notes' "Simple Pseudo-code".
 //
 // Objects in the frustum are taken nearest first. Occluders (occluder class
 // `always`, opaque) are drawn first as a pre-pass. Every other object is an
@@ -155,7 +155,7 @@ Registration perobject_registration() {
           .approximate_unless_default();
   return registered({"perobject",
                      "per-object async queries after an occluder pre-pass; visible objects re-tested every N frames "
-                     "(seed 002)",
+                     "(the engine notes)",
                      false},
                     table, [](const SceneIndex& index, const PerObjectConfig& c, const Options&, const CullerContext&) {
                       return std::make_unique<PerObjectCuller>(index, c);

@@ -1,4 +1,4 @@
-// `pertile`: per-tile CHC++ over a tiled world, no tile queries (seed 004's
+// `pertile`: per-tile CHC++ over a tiled world, no tile queries (Gomez et al. 2013's
 // "per-tile CHC++" comparison).
 //
 // Every cell of the window whose tile box is not outside the frustum is
@@ -42,7 +42,7 @@ Registration pertile_registration() {
       "frames a tile instance may go unused before its BVH instance and CHC++ context are freed");
   return registered({"pertile",
                      "tiled worlds: every tile instance in the frustum culled by its own CHC++ context, nearest first, "
-                     "no tile queries (seed 004)",
+                     "no tile queries (Gomez et al. 2013)",
                      true, {}, false, SceneKind::tiled},
                     table, [](const SceneIndex& index, const TileCacheConfig& c, const Options& o, const CullerContext&) {
                       return std::make_unique<PerTileCuller>(index, c, o);

@@ -1,7 +1,7 @@
 // Internal: the cache of tile instances the tiled-world cullers share — a
 // tile instance's BVH instance and, with a local culler, its culling
 // context (CHC++), keyed by tile coordinates, reused across frames and
-// freed after a number of frames unused (seed 004, Section III-B).
+// freed after a number of frames unused (Gomez et al. 2013, Section III-B).
 #pragma once
 #include "occull/culler.hpp"
 #include "occull/tiles.hpp"

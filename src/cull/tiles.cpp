@@ -1,5 +1,5 @@
 // `tiles`: tile queries with the common box and per-tile CHC++ over a tiled
-// world (Gomez et al. 2013, seed 004, Algorithms 1-4; occull/tiles.hpp).
+// world (Gomez et al. 2013, Algorithms 1-4; occull/tiles.hpp).
 //
 // Each frame starts at the nearest cell whose common box is in the frustum
 // (nothing is drawn yet, so it is visible: closestVisibleTileInFrustum),
@@ -17,7 +17,7 @@
 // point of a farther cell crosses the columns of a chain of neighbouring
 // cells (8-neighbours take the chains through corners) inside their common
 // boxes while it runs inside the boxes' height range, so each of those has a
-// visible point too (seed 004, Section III-C); from above the boxes, every
+// visible point too (Gomez et al. 2013, Section III-C); from above the boxes, every
 // box top in the frustum is seen over whatever lies below it. The verifier
 // checks it (and catches tiles.box=tile, which queries each tile's own box).
 //
@@ -214,11 +214,11 @@ Registration tiles_registration() {
                    "every frame, as the paper; N > 1 as CHC++ re-queries visible nodes)")
           .choice("box", &C::common_box, {{"common", true}, {"tile", false}},
                   "box a tile query draws: common (the union of every tile's box) or tile (the queried tile's own box: "
-                  "not conservative, seed 004's Figure 7, kept to show why)")
+                  "not conservative, Gomez et al. 2013's Figure 7, kept to show why)")
           .approximate_unless_default();
   return registered({"tiles",
                      "tiled worlds: visibility propagated tile to tile by queries of the common box, front to back, "
-                     "with temporal prediction; each visible tile culled by its own CHC++ (seed 004, Algorithms 1-4)",
+                     "with temporal prediction; each visible tile culled by its own CHC++ (Gomez et al. 2013, Algorithms 1-4)",
                      true, {}, false, SceneKind::tiled},
                     table, [](const SceneIndex& index, const C& c, const Options& o, const CullerContext&) {
                       return std::make_unique<TilesCuller>(index, c, o);

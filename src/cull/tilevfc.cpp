@@ -1,4 +1,4 @@
-// `tilevfc`: view-frustum culling over a tiled world (seed 004's baseline).
+// `tilevfc`: view-frustum culling over a tiled world (Gomez et al. 2013's baseline).
 //
 // Every cell of the window whose tile box is not outside the frustum is
 // visited nearest first; the objects of its tile instance are culled
@@ -50,7 +50,7 @@ Registration tilevfc_registration() {
       "frames a tile instance may go unused before its BVH instance is freed");
   return registered({"tilevfc",
                      "tiled worlds: view-frustum culling over the BVH of every tile instance in the frustum, nearest "
-                     "tile first (seed 004's baseline)",
+                     "tile first (Gomez et al. 2013's baseline)",
                      true, {}, false, SceneKind::tiled},
                     table, [](const SceneIndex& index, const TileCacheConfig& c, const Options& o, const CullerContext&) {
                       return std::make_unique<TileVfcCuller>(index, c, o);

@@ -214,7 +214,7 @@ class QuerySubmitter {
   std::uint32_t pending_ = 0;
 };
 
-/// The eye-inside rule (DESIGN, seed 002): a box that, grown by the near
+/// The eye-inside rule (DESIGN, the engine notes): a box that, grown by the near
 /// plane radius, contains the eye is visible without a query — its query
 /// could miss the faces around the camera, and an object that close is
 /// visible anyway.
@@ -236,7 +236,7 @@ void append_objects_in_frustum(const SceneIndex& index, NodeId n, const View& vi
 
 /// How a node's occlusion query is shaped.
 struct QueryShape {
-  bool tight = false;  ///< children's boxes (seed 000 "tighter bounding volumes")
+  bool tight = false;  ///< children's boxes (Bittner et al. 2009 "tighter bounding volumes")
   int d_max = 3;
   float s_max = 1.4f;
 };

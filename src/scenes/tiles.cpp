@@ -1,5 +1,5 @@
 // `tiles_city`, `tiles_forest`, `tiles_hybrid`: tiled worlds without edge
-// (seed 004), in the spirit of the paper's City, Forest and Hybrid sets.
+// (Gomez et al. 2013), in the spirit of the paper's City, Forest and Hybrid sets.
 //
 // Each tiling set is a few predefined tiles in 64 m cells, placed on the
 // XZ lattice by TiledWorld's tile function (occull/tiles.hpp). Every tile
@@ -279,15 +279,15 @@ SceneBundle make_tiled(Set set, const std::string& name, const Params& params) {
 }  // namespace
 
 SceneInfo tiles_city_info() {
-  return {"tiles_city", "tiled world without edge: city blocks of tall buildings (seed 004's City)",
+  return {"tiles_city", "tiled world without edge: city blocks of tall buildings (Gomez et al. 2013's City)",
           tile_params(400), {"walk10k", "grazing", "turn"}};
 }
 SceneInfo tiles_forest_info() {
-  return {"tiles_forest", "tiled world without edge: forest patches of dense conifers and rocks (seed 004's Forest)",
+  return {"tiles_forest", "tiled world without edge: forest patches of dense conifers and rocks (Gomez et al. 2013's Forest)",
           tile_params(300), {"walk10k", "grazing", "turn"}};
 }
 SceneInfo tiles_hybrid_info() {
-  return {"tiles_hybrid", "tiled world without edge: city blocks, forest patches and open squares (seed 004's Hybrid)",
+  return {"tiles_hybrid", "tiled world without edge: city blocks, forest patches and open squares (Gomez et al. 2013's Hybrid)",
           tile_params(400), {"walk10k", "grazing", "turn"}};
 }
 SceneBundle make_tiles_city(const Params& p) { return make_tiled(Set::city, "tiles_city", p); }

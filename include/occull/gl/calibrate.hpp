@@ -1,5 +1,5 @@
 // occull — startup calibration of the NOHC hardware cost model on the
-// current OpenGL renderer (seed 001, Section 3.2.2).
+// current OpenGL renderer (Guthe et al. 2006, Section 3.2.2).
 #pragma once
 
 #include "occull/cost_model.hpp"
