@@ -56,7 +56,7 @@ PREFIX ?= /usr/local
 install: build
 	cmake --install $(BUILD) --prefix $(PREFIX)
 
-# A folder (.gpu/) to run occull on a GPU machine without a package registry (README, "On a GPU").
+# A folder (.gpu/) to run occull on a GPU machine without a package registry (docs/cli.md, "On a GPU").
 gpu-pack: deps
 	./scripts/gpu-pack.sh .gpu
 

@@ -63,14 +63,14 @@ class TilesCuller final : public Culler {
 
     pending_.clear();
     postponed_.clear();
-    std::optional<TileCoord> t = closestVisibleTileInFrustum();
+    std::optional<TileCoord> t = closest_visible_tile_in_frustum();
     if (t) state(*t).queried_frame = frame_;
     while (t) {
       cache_.render(cache_.fetch(*t), view, backend);  // renderWithCHC++(fetchBVHInstance(T))
-      queryNeighbors(*t);
-      t = getNextPositiveQuery();
+      query_neighbors(*t);
+      t = next_positive_query();
     }
-    updatePostponedQueryQueue();
+    update_postponed_queries();
     cache_.end_frame();
     prune();
     stats_ = nullptr;
@@ -105,9 +105,11 @@ class TilesCuller final : public Culler {
     return std::uint64_t(std::uint32_t(c.x) * 73856093u ^ std::uint32_t(c.z) * 19349663u);
   }
 
-  std::optional<TileCoord> closestVisibleTileInFrustum() { return nearest_cell_in_frustum(world_, *view_); }
+  // closestVisibleTileInFrustum (Algorithm 1, line 3)
+  std::optional<TileCoord> closest_visible_tile_in_frustum() { return nearest_cell_in_frustum(world_, *view_); }
 
-  void queryNeighbors(TileCoord t) {
+  // queryNeighbors (Algorithm 2)
+  void query_neighbors(TileCoord t) {
     static constexpr int kOffsets[8][2] = {{1, 0}, {-1, 0}, {0, 1}, {0, -1}, {1, 1}, {1, -1}, {-1, 1}, {-1, -1}};
     for (int i = 0; i < neighbors_; ++i) {
       const TileCoord n{t.x + kOffsets[i][0], t.z + kOffsets[i][1]};
@@ -132,7 +134,8 @@ class TilesCuller final : public Culler {
     }
   }
 
-  std::optional<TileCoord> getNextPositiveQuery() {
+  // getNextPositiveQuery (Algorithm 3)
+  std::optional<TileCoord> next_positive_query() {
     while (!pending_.empty()) {
       const Pending p = pending_.front();
       pending_.pop_front();
@@ -156,7 +159,8 @@ class TilesCuller final : public Culler {
     return std::nullopt;
   }
 
-  void updatePostponedQueryQueue() {
+  // updatePostponedQueryQueue (Algorithm 4)
+  void update_postponed_queries() {
     for (const Pending& p : postponed_) {
       CellState& s = state(p.cell);
       if (backend_->result_available(p.query)) {
