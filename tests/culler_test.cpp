@@ -1,6 +1,7 @@
 #include "occull/cost_model.hpp"
 #include "occull/culler.hpp"
 #include "occull/error.hpp"
+#include "occull/grid_views.hpp"
 #include "test_util.hpp"
 
 #include <gtest/gtest.h>
@@ -195,4 +196,19 @@ TEST(MakeCuller, AsksTheContextForNohcsProfileOnlyWhenACullerNeedsIt) {
   (void)make_culler("auto", {scene, bvh}, {}, context);  // the default candidates take nohc when a profile is at hand
   EXPECT_EQ(asked, 2);
   (void)make_culler("auto", {scene, bvh});  // ... and leave it out when none is
+}
+
+TEST(MakeSplitScreen, AlgorithmsThatShareViewsMakeThemTogetherTheOthersOnePerView) {
+  const Scene scene = scattered(40, 5);
+  const Bvh bvh = Bvh::build(scene);
+  auto grid = make_split_screen("grid:cap=100", {scene, bvh}, 3);
+  EXPECT_EQ(grid->size(), 3);
+  EXPECT_NE(dynamic_cast<GridViews*>(grid.get()), nullptr) << "grid's views share one grid and query cap";
+  EXPECT_TRUE(find_algorithm("grid").shares_views);
+  auto chcpp = make_split_screen("chcpp", {scene, bvh}, 2);
+  EXPECT_EQ(chcpp->size(), 2);
+  EXPECT_NE(&chcpp->view(0), &chcpp->view(1));
+  EXPECT_THROW((void)make_split_screen("chcpp", {scene, bvh}, 0), InputError);
+  EXPECT_THROW((void)make_split_screen("grid:nope=1", {scene, bvh}, 2), InputError);
+  EXPECT_THROW((void)make_split_screen("oracle", {scene, bvh}, 2), InputError);  // harness only
 }

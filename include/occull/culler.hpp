@@ -184,6 +184,9 @@ struct AlgorithmInfo {
   /// (`oracle`); make_culler() refuses it.
   bool harness_only = false;
   SceneKind scenes = SceneKind::bvh;
+  /// Its cullers of the views of one frame share state (`grid`: one grid
+  /// and one query cap), so make_split_screen() makes them together.
+  bool shares_views = false;
 };
 
 /// Every algorithm make_culler() knows, in presentation order.
@@ -250,5 +253,26 @@ struct CullerContext {
 /// the message lists those that do), or nohc without a profile.
 [[nodiscard]] std::unique_ptr<Culler> make_culler(std::string_view spec, const SceneIndex& index,
                                                   const Options& options = {}, const CullerContext& context = {});
+
+/// The cullers of the views of one frame (split screen), one per view.
+class SplitScreen {
+ public:
+  virtual ~SplitScreen() = default;
+  [[nodiscard]] virtual int size() const noexcept = 0;
+  /// The culler of view `k` (0-based); render each view's frame with it.
+  [[nodiscard]] virtual Culler& view(int k) = 0;
+  /// Call once per frame before the views render (cullers that share a
+  /// budget split it here).
+  virtual void begin_frame() {}
+};
+
+/// The cullers of `views` views (1 to 16) of one frame, for a spec as
+/// make_culler() takes it: made together where the algorithm shares state
+/// between views (AlgorithmInfo::shares_views), else one make_culler() per
+/// view. Throws InputError as make_culler() does, and for a view count out
+/// of range.
+[[nodiscard]] std::unique_ptr<SplitScreen> make_split_screen(std::string_view spec, const SceneIndex& index,
+                                                             int views, const Options& options = {},
+                                                             const CullerContext& context = {});
 
 }  // namespace occull

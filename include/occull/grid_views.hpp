@@ -109,7 +109,7 @@ class QueryBudget {
 };
 
 /// One grid culler per view over one shared grid and query budget.
-class GridViews {
+class GridViews final : public SplitScreen {
  public:
   /// A `grid` culler per view, with `options` (grid.*; grid.cap is the
   /// total of all views, grid.split the QueryBudget's policy, reveal or
@@ -121,13 +121,13 @@ class GridViews {
   GridViews(const GridViews&) = delete;
   GridViews& operator=(const GridViews&) = delete;
 
-  [[nodiscard]] int size() const noexcept { return int(views_.size()); }
+  [[nodiscard]] int size() const noexcept override { return int(views_.size()); }
   /// The culler of view `k` (0-based); render each view's frame with it.
-  [[nodiscard]] Culler& view(int k) { return *views_.at(std::size_t(k)); }
+  [[nodiscard]] Culler& view(int k) override { return *views_.at(std::size_t(k)); }
 
   /// Call once per frame before the views render: splits the query cap
   /// from what the views' queries found.
-  void begin_frame() { budget_->split(); }
+  void begin_frame() override { budget_->split(); }
 
   [[nodiscard]] const QueryBudget& budget() const noexcept { return *budget_; }
   [[nodiscard]] const UniformGrid& grid() const noexcept { return *grid_; }

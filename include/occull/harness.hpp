@@ -188,6 +188,10 @@ class Session {
   /// InputError like make_culler().
   [[nodiscard]] std::unique_ptr<Culler> make(std::string_view spec, const Options& options,
                                              const std::function<void(const std::string&)>& progress = {});
+  /// What cullers made for this session get: nohc's profile from
+  /// hardware_profile() (calibrated on first use, its lines to `progress`).
+  /// Valid while the session lives.
+  [[nodiscard]] CullerContext culler_context(const std::function<void(const std::string&)>& progress = {});
   /// Whether hardware_profile() has been loaded or calibrated in this session.
   [[nodiscard]] bool has_hardware_profile() const noexcept { return profile_.has_value(); }
 

@@ -161,10 +161,18 @@ struct NoOptions {};
 /// How the registry makes an algorithm from options (null: harness only).
 using Factory = std::function<std::unique_ptr<Culler>(const SceneIndex&, const Options&, const CullerContext&)>;
 
+/// How the registry makes the cullers of several views together (null: one
+/// culler per view, each by the Factory).
+using SplitFactory =
+    std::function<std::unique_ptr<SplitScreen>(const SceneIndex&, int views, const Options&, const CullerContext&)>;
+
 /// An algorithm as the registry holds it.
 struct Registration {
   AlgorithmInfo info;
   Factory make;
+  SplitFactory make_views;  ///< set with info.shares_views
+  /// Variants `occull bench` runs by default besides the plain name.
+  std::vector<std::string> bench_variants;
   /// Whether options make a run approximate (null: never).
   std::function<bool(const Options&)> approximate;
 };
@@ -177,7 +185,7 @@ template <class Config, class Make>
 Registration registered(AlgorithmInfo info, const ConfigTable<Config>& table, Make make) {
   info.options = table.describe();
   const std::string name = info.name;
-  Registration r{std::move(info), {}, {}};
+  Registration r{std::move(info), {}, {}, {}, {}};
   r.make = [&table, name, make](const SceneIndex& index, const Options& o, const CullerContext& context) {
     return make(index, table.parse(o, name), o, context);
   };

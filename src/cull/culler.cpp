@@ -28,6 +28,8 @@ const std::vector<Registration>& registry() {
     r.push_back({{"oracle", "renders exactly the ground-truth visible set, no queries: the lower bound (occull bench only)",
                   true, {}, true, SceneKind::any},
                  {},
+                 {},
+                 {},
                  {}});
     return r;
   }();
@@ -144,7 +146,7 @@ std::vector<std::string> default_algorithms(bool tiled) {
   for (const Registration& e : registry()) {
     if (!runs_on(e.info, tiled)) continue;
     names.push_back(e.info.name);
-    if (e.info.name == "tiles") names.push_back("tiles:local=none");
+    names.insert(names.end(), e.bench_variants.begin(), e.bench_variants.end());
   }
   return names;
 }
@@ -215,14 +217,12 @@ std::vector<ObjectId> objects_not_drawn(const Scene& scene, const View& view, st
   return out;
 }
 
-std::unique_ptr<Culler> make_culler(std::string_view spec_text, const SceneIndex& index, const Options& base,
-                                    const CullerContext& context) {
-  const AlgorithmSpec spec = parse_algorithm_spec(spec_text, base);
-  const Options& options = spec.options;
+namespace {
+
+// The registration a spec names, checked to run on `index`'s kind of scene
+// and outside the harness. Throws InputError otherwise.
+const Registration& makeable(const AlgorithmSpec& spec, const SceneIndex& index) {
   const Registration* entry = find(spec.name);
-  const std::string prefix = entry->info.name + ".";
-  for (const auto& [key, value] : options.values())
-    if (key.rfind(prefix, 0) == 0) check_option(*entry, key, key.substr(prefix.size()));
   if (!entry->make)
     throw InputError(fmt::format("{} needs each frame's ground truth: it runs only in the harness "
                                  "(occull bench)",
@@ -236,7 +236,37 @@ std::unique_ptr<Culler> make_culler(std::string_view spec_text, const SceneIndex
                                  tiled ? "a tiled world (it has no global BVH)" : "a scene that is not a tiled world",
                                  fits));
   }
-  return entry->make(index, options, context);
+  return *entry;
+}
+
+// Independent cullers, one per view.
+class IndependentViews final : public SplitScreen {
+ public:
+  explicit IndependentViews(std::vector<std::unique_ptr<Culler>> views) : views_(std::move(views)) {}
+  [[nodiscard]] int size() const noexcept override { return int(views_.size()); }
+  [[nodiscard]] Culler& view(int k) override { return *views_.at(std::size_t(k)); }
+
+ private:
+  std::vector<std::unique_ptr<Culler>> views_;
+};
+
+}  // namespace
+
+std::unique_ptr<Culler> make_culler(std::string_view spec_text, const SceneIndex& index, const Options& base,
+                                    const CullerContext& context) {
+  const AlgorithmSpec spec = parse_algorithm_spec(spec_text, base);
+  return makeable(spec, index).make(index, spec.options, context);
+}
+
+std::unique_ptr<SplitScreen> make_split_screen(std::string_view spec_text, const SceneIndex& index, int views,
+                                               const Options& base, const CullerContext& context) {
+  if (views < 1 || views > 16) throw InputError(fmt::format("{} views: must be in [1, 16]", views));
+  const AlgorithmSpec spec = parse_algorithm_spec(spec_text, base);
+  const Registration& entry = makeable(spec, index);
+  if (entry.make_views) return entry.make_views(index, views, spec.options, context);
+  std::vector<std::unique_ptr<Culler>> cullers;
+  for (int k = 0; k < views; ++k) cullers.push_back(entry.make(index, spec.options, context));
+  return std::make_unique<IndependentViews>(std::move(cullers));
 }
 
 }  // namespace occull

@@ -346,14 +346,19 @@ const ConfigTable<GridConfig>& grid_table() {
 }  // namespace
 
 Registration grid_registration() {
-  return registered({"grid",
-                     "uniform grid in occlusion order, cell queries read a frame later, occluder pre-pass, per-frame "
-                     "query cap (Seletsky 2013); may pop",
-                     false},
-                    grid_table(), [](const SceneIndex& index, const GridConfig& c, const Options&, const CullerContext&) {
-                      return std::make_unique<GridCuller>(
-                          index, c, std::make_shared<UniformGrid>(UniformGrid::of_scene(index.scene, c.cell)));
-                    });
+  Registration r = registered(
+      {"grid",
+       "uniform grid in occlusion order, cell queries read a frame later, occluder pre-pass, per-frame query cap "
+       "(Seletsky 2013); may pop",
+       false, {}, false, SceneKind::bvh, /*shares_views=*/true},
+      grid_table(), [](const SceneIndex& index, const GridConfig& c, const Options&, const CullerContext&) {
+        return std::make_unique<GridCuller>(index, c,
+                                            std::make_shared<UniformGrid>(UniformGrid::of_scene(index.scene, c.cell)));
+      });
+  r.make_views = [](const SceneIndex& index, int views, const Options& o, const CullerContext&) {
+    return std::make_unique<GridViews>(index, views, o);
+  };
+  return r;
 }
 
 }  // namespace occull::detail

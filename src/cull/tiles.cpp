@@ -220,13 +220,15 @@ Registration tiles_registration() {
                   "box a tile query draws: common (the union of every tile's box) or tile (the queried tile's own box: "
                   "not conservative, Gomez et al. 2013's Figure 7, kept to show why)")
           .approximate_unless_default();
-  return registered({"tiles",
+  Registration r = registered({"tiles",
                      "tiled worlds: visibility propagated tile to tile by queries of the common box, front to back, "
                      "with temporal prediction; each visible tile culled by its own CHC++ (Gomez et al. 2013, Algorithms 1-4)",
                      true, {}, false, SceneKind::tiled},
                     table, [](const SceneIndex& index, const C& c, const Options& o, const CullerContext&) {
                       return std::make_unique<TilesCuller>(index, c, o);
                     });
+  r.bench_variants = {"tiles:local=none"};  // the paper's "tile query alone"
+  return r;
 }
 
 }  // namespace occull::detail

@@ -3,7 +3,6 @@
 #include "occull/frame_log.hpp"
 
 #include "watchdog.hpp"
-#include "occull/grid_views.hpp"
 
 #include "occull/error.hpp"
 #include "occull/gl/calibrate.hpp"
@@ -316,9 +315,13 @@ std::unique_ptr<Culler> Session::make(std::string_view spec, const Options& opti
                                       const std::function<void(const std::string&)>& progress) {
   const AlgorithmSpec a = parse_algorithm_spec(spec, options);
   if (a.name == "oracle") return std::make_unique<detail::OracleCuller>(bundle_.scene);
+  return make_culler(a.name, index(), a.options, culler_context(progress));
+}
+
+CullerContext Session::culler_context(const std::function<void(const std::string&)>& progress) {
   CullerContext context;  // nohc: the calibrated profile, unless an option names a file
-  context.nohc_profile_source = [&]() -> const HardwareProfile& { return hardware_profile(progress); };
-  return make_culler(a.name, index(), a.options, context);
+  context.nohc_profile_source = [this, progress]() -> const HardwareProfile& { return hardware_profile(progress); };
+  return context;
 }
 
 std::string Session::renderer_key() const { return device_.renderer + " | " + device_.version; }
@@ -651,23 +654,23 @@ void add_view(FrameStats& sum, const FrameStats& v) {
   sum.extra_objects += v.extra_objects;
 }
 
-// The cullers of the views of one split-screen run: `grid` shares its grid
-// and query cap between them (GridViews); any other algorithm runs one
-// independent culler per view.
+// The cullers of the views of one split-screen run: make_split_screen's
+// (an algorithm that shares state between views makes them together), or
+// the session's, one per view, for the harness-only oracle.
 struct ViewCullers {
-  std::unique_ptr<GridViews> grid;
+  std::unique_ptr<SplitScreen> split;
   std::vector<std::unique_ptr<Culler>> own;
 
   ViewCullers(Session& session, const std::string& name, const Options& options, int views) {
     const AlgorithmSpec spec = parse_algorithm_spec(name, options);
-    if (spec.name == "grid")
-      grid = std::make_unique<GridViews>(session.index(), views, spec.options);
-    else
+    if (find_algorithm(spec.name).harness_only)
       for (int k = 0; k < views; ++k) own.push_back(session.make(name, options));
+    else
+      split = make_split_screen(name, session.index(), views, options, session.culler_context());
   }
-  Culler& view(int k) { return grid ? grid->view(k) : *own.at(std::size_t(k)); }
+  Culler& view(int k) { return split ? split->view(k) : *own.at(std::size_t(k)); }
   void begin_frame() {
-    if (grid) grid->begin_frame();
+    if (split) split->begin_frame();
   }
   void release(Session& session, int views) {
     for (int k = 0; k < views; ++k) session.release(view(k));
