@@ -72,7 +72,6 @@ std::vector<ObjectId> check_frame(std::span<const gl::Renderer::ObjectPixels> tr
                                   std::span<const ObjectId> rendered, std::size_t object_count,
                                   FrameStats& stats);
 
-/// Frames of one algorithm over a path (one repeat).
 /// The process's memory after a frame of a run (every kMemorySampleFrames).
 struct MemorySample {
   int frame = 0;        ///< frames of the run done (1000, 2000, ...)
@@ -82,6 +81,7 @@ struct MemorySample {
 /// Frames between two MemorySamples of a run.
 inline constexpr int kMemorySampleFrames = 1000;
 
+/// Frames of one algorithm over a path (one repeat).
 struct AlgorithmRun {
   std::string name;
   int repeat = 0;
@@ -195,8 +195,6 @@ class Session {
   /// Whether hardware_profile() has been loaded or calibrated in this session.
   [[nodiscard]] bool has_hardware_profile() const noexcept { return profile_.has_value(); }
 
-  /// Runs `culler` over frames 0..frames-1 of `path`. With `truth` (one
-  /// entry per frame), verifies every frame; the oracle needs it.
   /// Runs frame k of `frames` along `path` (feeding the oracle that
   /// frame's truth; it needs `truth`). Timings as run_frame.
   FrameStats run_path_frame(Culler& culler, const CameraPath& path, int k, int frames,
@@ -213,9 +211,11 @@ class Session {
   /// else "object 812 (mesh 5)".
   [[nodiscard]] std::string describe_object(ObjectId id) const;
 
-  /// With `predict`, also fills FrameStats::model_ms (see predicted_frame_ms).
-  /// With `truth`, checks every frame against it (frame-within-truth, and
-  /// oracle-draws-truth for the oracle); throws InvariantViolation.
+  /// Runs `culler` over frames 0..frames-1 of `path`. With `truth` (one
+  /// entry per frame), checks every frame against it (frame-within-truth,
+  /// and oracle-draws-truth for the oracle; the oracle needs it); throws
+  /// InvariantViolation. With `predict`, also fills FrameStats::model_ms
+  /// (see predicted_frame_ms).
   AlgorithmRun run_path(std::string_view name, Culler& culler, const CameraPath& path, int frames,
                         const std::vector<FrameTruth>* truth, const ProgressFn& progress = {},
                         bool predict = false);
