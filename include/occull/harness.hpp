@@ -210,6 +210,8 @@ class Session {
   /// object 12" in a tiled world (its ids are reused as the window moves),
   /// else "object 812 (mesh 5)".
   [[nodiscard]] std::string describe_object(ObjectId id) const;
+  /// The process's memory now, as the sample after `frame` frames of a run.
+  [[nodiscard]] MemorySample memory_sample(int frame) const;
 
   /// Runs `culler` over frames 0..frames-1 of `path`. With `truth` (one
   /// entry per frame), checks every frame against it (frame-within-truth,

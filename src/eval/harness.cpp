@@ -404,15 +404,16 @@ AlgorithmRun Session::run_path(std::string_view name, Culler& culler, const Came
       misses.add(missed);
     }
     run.frames[std::size_t(k)] = s;
-    if ((k + 1) % kMemorySampleFrames == 0) {
-      const MemoryUsage m = memory_usage();
-      run.memory.push_back({k + 1, double(m.resident_bytes) / (1 << 20),
-                            double(renderer_->resources().buffer_bytes) / (1 << 20)});
-    }
+    if ((k + 1) % kMemorySampleFrames == 0) run.memory.push_back(memory_sample(k + 1));
     if (progress) progress(name, k, frames, false);
   }
   run.longest_miss_frames = misses.longest();
   return run;
+}
+
+MemorySample Session::memory_sample(int frame) const {
+  const MemoryUsage m = memory_usage();
+  return {frame, double(m.resident_bytes) / (1 << 20), double(renderer_->resources().buffer_bytes) / (1 << 20)};
 }
 
 std::string Session::describe_object(ObjectId id) const {
@@ -654,6 +655,12 @@ void add_view(FrameStats& sum, const FrameStats& v) {
   sum.extra_objects += v.extra_objects;
 }
 
+// The frame of the path warm-up frame `w` runs: the warm-up frames are
+// spread over the path, so each algorithm sees its whole length once.
+int warmup_frame(const BenchConfig& config, int w) {
+  return config.warmup > 1 ? w * (config.frames - 1) / (config.warmup - 1) : 0;
+}
+
 // The cullers of the views of one split-screen run: make_split_screen's
 // (an algorithm that shares state between views makes them together), or
 // the session's, one per view, for the harness-only oracle.
@@ -688,7 +695,7 @@ void run_split_screen(Session& session, const std::string& name, const BenchConf
   {
     ViewCullers warm(session, name, config.options, views);
     for (int w = 0; w < config.warmup; ++w) {
-      const int f = config.warmup > 1 ? w * (config.frames - 1) / (config.warmup - 1) : 0;
+      const int f = warmup_frame(config, w);
       warm.begin_frame();
       for (int k = 0; k < views; ++k)
         (void)session.run_path_frame(warm.view(k), *paths[std::size_t(k)], f, config.frames, truth_of(k));
@@ -711,14 +718,22 @@ void run_split_screen(Session& session, const std::string& name, const BenchConf
     for (int k = 0; k < views; ++k) {
       const CameraPath& path = *paths[std::size_t(k)];
       FrameStats s = session.run_path_frame(cullers.view(k), path, f, config.frames, truth_of(k));
-      if (config.verify)
-        misses[std::size_t(k)].add(session.verify_frame(each[std::size_t(k)].name, cullers.view(k), path, f,
-                                                        truths[std::size_t(k)][std::size_t(f)], s));
+      if (config.verify) {
+        const std::vector<ObjectId> missed = session.verify_frame(each[std::size_t(k)].name, cullers.view(k), path,
+                                                                  f, truths[std::size_t(k)][std::size_t(f)], s);
+        // As run_path records it, for the whole run and for the view.
+        if (!missed.empty() && each[std::size_t(k)].first_miss.empty())
+          each[std::size_t(k)].first_miss = fmt::format("frame {}: {}", f, session.describe_object(missed.front()));
+        if (!missed.empty() && whole.first_miss.empty())
+          whole.first_miss = fmt::format("view {}, frame {}: {}", k + 1, f, session.describe_object(missed.front()));
+        misses[std::size_t(k)].add(missed);
+      }
       add_view(sum, s);
       each[std::size_t(k)].frames.push_back(s);
     }
     sum.result_age /= double(views);
     whole.frames.push_back(sum);
+    if ((f + 1) % kMemorySampleFrames == 0) whole.memory.push_back(session.memory_sample(f + 1));
     if (progress) progress(label, f, config.frames, false);
   }
   cullers.release(session, views);
@@ -878,7 +893,7 @@ BenchResult run_bench(const BenchConfig& config, const ProgressFn& progress) {
       {
         auto warm = session.make(name, config.options);
         for (int k = 0; k < config.warmup; ++k) {
-          const int f = config.warmup > 1 ? k * (config.frames - 1) / (config.warmup - 1) : 0;
+          const int f = warmup_frame(config, k);
           (void)session.run_path_frame(*warm, path, f, config.frames, truth_ptr);
           if (progress) progress(label, k, config.warmup, true);
         }
