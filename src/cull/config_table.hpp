@@ -30,23 +30,13 @@ class ConfigTable {
   /// A whole number in [lo, hi].
   template <class At>
   ConfigTable&& integer(std::string key, At at, int lo, int hi, std::string help) && {
-    add(std::move(key), std::move(help), fmt::format("[{}, {}]", lo, hi),
-        [at, lo, hi](Config& c, const Options& o, const std::string& k) {
-          auto& m = std::invoke(at, c);
-          m = static_cast<std::remove_reference_t<decltype(m)>>(o.get_int(k, int(m), lo, hi));
-        },
-        [at](const Config& c) { return fmt::format("{}", std::invoke(at, c)); });
+    number(std::move(key), at, lo, hi, std::move(help));
     return std::move(*this);
   }
   /// A finite number in [lo, hi].
   template <class At>
   ConfigTable&& real(std::string key, At at, double lo, double hi, std::string help) && {
-    add(std::move(key), std::move(help), fmt::format("[{}, {}]", lo, hi),
-        [at, lo, hi](Config& c, const Options& o, const std::string& k) {
-          auto& m = std::invoke(at, c);
-          m = static_cast<std::remove_reference_t<decltype(m)>>(o.get_double(k, double(m), lo, hi));
-        },
-        [at](const Config& c) { return fmt::format("{}", std::invoke(at, c)); });
+    number(std::move(key), at, lo, hi, std::move(help));
     return std::move(*this);
   }
   /// on/off (also true/false, yes/no, 1/0).
@@ -139,6 +129,20 @@ class ConfigTable {
   }
 
  private:
+  // A number field read by Options::get_int (Bound int) or get_double.
+  template <class At, class Bound>
+  void number(std::string key, At at, Bound lo, Bound hi, std::string help) {
+    add(std::move(key), std::move(help), fmt::format("[{}, {}]", lo, hi),
+        [at, lo, hi](Config& c, const Options& o, const std::string& k) {
+          auto& m = std::invoke(at, c);
+          using T = std::remove_reference_t<decltype(m)>;
+          if constexpr (std::is_same_v<Bound, int>)
+            m = static_cast<T>(o.get_int(k, int(m), lo, hi));
+          else
+            m = static_cast<T>(o.get_double(k, double(m), lo, hi));
+        },
+        [at](const Config& c) { return fmt::format("{}", std::invoke(at, c)); });
+  }
   struct Field {
     OptionInfo info;
     std::function<void(Config&, const Options&, const std::string&)> read;
