@@ -146,6 +146,13 @@ class Session {
   /// llvmpipe: after `perobject`'s thousands of small flushes per frame,
   /// chc/chcpp in the same context ran 10-20% slower for the rest of the
   /// process). Costs a fraction of a second.
+  ///
+  /// The replaced context is not destroyed at once: it stays, idle, until
+  /// the next replacement (or the session's end) destroys it. Destroyed
+  /// right after its last frame, llvmpipe's rasterizer threads could still
+  /// be leaving that frame's scene when the context freed it, and about one
+  /// bench in 25-120 died of heap corruption in the next algorithm's first
+  /// frames (docs/performance.md, "A crash in the driver").
   void reset_renderer();
 
   /// Runs one frame: moves dynamic objects to `time_s` (untimed), then
@@ -304,6 +311,7 @@ class Session {
   // The scene at path time `time_s`: Motions, then the engine's moves.
   void advance_scene(double time_s);
   Bvh bvh_;
+  std::unique_ptr<gl::Context> retired_;  // the context reset_renderer() replaced last, idle (see there)
   std::unique_ptr<gl::Context> context_;
   gl::DeviceInfo device_;
   gl::RendererOptions renderer_options_;

@@ -127,7 +127,8 @@ void Session::reset_renderer() {
   logger_.reset();
   guard_.reset();
   renderer_.reset();
-  context_.reset();
+  retired_.reset();  // idle since the previous replacement
+  retired_ = std::move(context_);
   context_ = gl::Context::create(context_options_);
   renderer_ = std::make_unique<gl::Renderer>(bundle_.scene, renderer_options_);
   set_stall_guard(stall_guard_ms_);
@@ -138,6 +139,7 @@ Session::~Session() {
   guard_.reset();     // reads the queries it gave up on
   renderer_.reset();  // GL objects go before the context
   context_.reset();
+  retired_.reset();
 }
 
 const CameraPath& Session::path(std::string_view name) {

@@ -182,8 +182,12 @@ void Context::release() { eglMakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFAC
 
 Context::~Context() {
   if (display_) {
-    if (eglGetCurrentContext() == context_) glFinish();  // no work in flight when the context goes
-    eglMakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
+    // No work in flight when the context goes; a context that is not
+    // current (Session's retired one) leaves the current one alone.
+    if (eglGetCurrentContext() == context_) {
+      glFinish();
+      eglMakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
+    }
     if (context_) eglDestroyContext(display_, context_);
     // No eglTerminate: the display is shared by every context of the process
     // (eglGetPlatformDisplay returns the same one), and terminating it makes
