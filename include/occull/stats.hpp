@@ -7,7 +7,9 @@ namespace occull {
 
 /// What one frame of one culler cost. A culler fills the counters it owns
 /// (nodes_visited, multiqueries, ...); the harness adds the backend's
-/// counters and the timings. Times in milliseconds.
+/// counters and the timings. Times in milliseconds. Every member has its
+/// row in occull/counters.hpp (how it is summarised, its JSON key and CSV
+/// column); a member without one fails Counters.EveryFrameStatsMemberHasARow.
 struct FrameStats {
   // Timings.
   double frame_ms = 0.0;  ///< wall time of the whole frame, closed by glFinish

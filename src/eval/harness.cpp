@@ -1,4 +1,5 @@
 #include "occull/harness.hpp"
+#include "occull/counters.hpp"
 
 #include "occull/frame_log.hpp"
 
@@ -186,20 +187,7 @@ FrameStats Session::run_frame(Culler& culler, const View& view, double time_s, F
   s.kernel_ms = u1.kernel_ms - u0.kernel_ms;
   s.frame_ms = ms_between(t0, t1);
   s.cpu_ms = std::max(0.0, ms_between(c0, c1) - during.backend_ms);
-  s.wait_ms = d.wait_ms;
-  s.queries = d.queries;
-  s.query_boxes = d.query_boxes;
-  s.state_changes = d.state_changes;
-  s.blocking_waits = d.blocking_waits;
-  s.flushes = d.flushes;
-  s.material_changes = d.material_changes;
-  s.render_flushes = d.render_flushes;
-  s.draw_calls = d.draw_calls;
-  s.triangles = d.triangles;
-  s.objects_rendered = d.objects_rendered;
-  s.conditional_objects = d.conditional_objects;
-  s.conditional_skipped = d.conditional_skipped;
-  s.stalled = d.stalled_results;
+  copy_backend_counters(d, s);
   context_->check("the end of a frame");
   culler.frame_finished(s);
   return s;
@@ -458,7 +446,35 @@ Summary summarize(std::vector<double> v) {
   return s;
 }
 
+namespace {
+
+// One repeat's figure of a counter from the sum, the largest value and the
+// number of its frames (Counter::frames).
+double run_figure(const Counter& c, double sum, double largest, double frames) {
+  switch (c.frames) {
+    case Combine::mean: return sum / frames;
+    case Combine::sum: return sum;
+    case Combine::max: return largest;
+    default: return 0.0;
+  }
+}
+
+// Puts a counter's figure into its summary member (Counter::summary).
+void set_summary(const Counter& c, AlgorithmSummary& a, double value) {
+  std::visit(
+      [&](auto member) {
+        if constexpr (!std::is_same_v<decltype(member), std::monostate>) {
+          using T = std::remove_reference_t<decltype(a.*member)>;
+          a.*member = static_cast<T>(value);
+        }
+      },
+      c.summary);
+}
+
+}  // namespace
+
 std::vector<AlgorithmSummary> summarize_runs(std::span<const AlgorithmRun> runs) {
+  const std::span<const Counter> counters = frame_counters();
   // Per repeat: the mean frame time of each algorithm, for ratios within it.
   std::map<std::pair<int, std::string>, double> mean_ms;
   std::vector<std::string> names;
@@ -468,81 +484,52 @@ std::vector<AlgorithmSummary> summarize_runs(std::span<const AlgorithmRun> runs)
     mean_ms[{r.repeat, r.name}] = summarize(ms).mean;
     if (std::find(names.begin(), names.end(), r.name) == names.end()) names.push_back(r.name);
   }
+  const auto sum_of = [&](const std::vector<double>& sums, std::string_view name) {
+    return sums[std::size_t(find_counter(name) - counters.data())];
+  };
 
   std::vector<AlgorithmSummary> out;
   for (const std::string& name : names) {
     AlgorithmSummary a;
     a.name = name;
-    // Figures per repeat, then medians across repeats.
+    // Each counter's figure per repeat (Counter::frames), then over the
+    // repeats (Counter::repeats); the derived figures beside them.
+    std::vector<std::vector<double>> counter_repeats(counters.size());
     std::map<std::string, std::vector<double>> per_repeat;
     for (const AlgorithmRun& r : runs) {
       if (r.name != name) continue;
       a.conservative = r.conservative;
       const double n = std::max<double>(1.0, double(r.frames.size()));
-      std::vector<double> ms;
-      std::map<std::string, double> sums;
-      std::uint64_t missed = 0, frames_missing = 0, wrong = 0, worst = 0, truth = 0;
-      double tile_cache_max = 0.0;
+      std::vector<double> ms, sums(counters.size(), 0.0), largest(counters.size(), 0.0);
+      std::uint64_t frames_missing = 0, worst = 0;
       for (const FrameStats& f : r.frames) {
         ms.push_back(f.frame_ms);
-        sums["queries"] += double(f.queries);
-        sums["multiqueries"] += double(f.multiqueries);
-        sums["failed_multiqueries"] += double(f.failed_multiqueries);
-        sums["query_batches"] += double(f.query_batches);
-        sums["capped"] += double(f.capped);
-        sums["over_cap"] += double(f.over_cap);
-        sums["result_age"] += f.result_age;
-        sums["revealed"] += double(f.revealed);
-        sums["state_changes"] += double(f.state_changes);
-        sums["render_flushes"] += double(f.render_flushes);
-        sums["draw_calls"] += double(f.draw_calls);
-        sums["triangles"] += double(f.triangles);
-        sums["objects_rendered"] += double(f.objects_rendered);
-        sums["conditional_objects"] += double(f.conditional_objects);
-        sums["conditional_skipped"] += double(f.conditional_skipped);
-        sums["stalled"] += double(f.stalled);
-        sums["tiles_rendered"] += double(f.tiles_rendered);
-        sums["tile_queries"] += double(f.tile_queries);
-        sums["tile_postponed"] += double(f.tile_postponed);
-        sums["tile_prediction_failures"] += double(f.tile_prediction_failures);
-        sums["tiles_instantiated"] += double(f.tiles_instantiated);
-        sums["tiles_evicted"] += double(f.tiles_evicted);
-        sums["instantiate_ms"] += f.instantiate_ms;
-        tile_cache_max = std::max(tile_cache_max, double(f.tile_cache));
-        sums["nodes_visited"] += double(f.nodes_visited);
-        sums["extra_objects"] += double(f.extra_objects);
-        sums["wait_ms"] += f.wait_ms;
-        sums["blocking_waits"] += double(f.blocking_waits);
-        sums["flushes"] += double(f.flushes);
-        sums["cpu_ms"] += f.cpu_ms;
-        sums["gpu_ms"] += f.gpu_ms;
-        sums["model_ms"] += f.model_ms;
-        sums["kernel_ms"] += f.kernel_ms;
-        sums["minor_faults"] += double(f.minor_faults);
-        sums["major_faults"] += double(f.major_faults);
-        missed += f.missed_objects;
-        truth += f.truth_objects;
+        for (std::size_t c = 0; c < counters.size(); ++c) {
+          const double v = counter_value(counters[c], f);
+          sums[c] += v;
+          largest[c] = std::max(largest[c], v);
+        }
         frames_missing += f.missed_objects > 0 ? 1 : 0;
-        wrong += f.wrong_pixels;
         worst = std::max(worst, f.wrong_pixels);
       }
+      for (std::size_t c = 0; c < counters.size(); ++c)
+        if (counters[c].frames != Combine::none)
+          counter_repeats[c].push_back(run_figure(counters[c], sums[c], largest[c], n));
       const Summary s = summarize(ms);
       per_repeat["mean"].push_back(s.mean);
       per_repeat["median"].push_back(s.median);
       per_repeat["p95"].push_back(s.p95);
       per_repeat["max"].push_back(s.max);
-      for (const auto& [key, sum] : sums) per_repeat[key].push_back(sum / n);
-      // Totals over the run rather than per frame.
-      per_repeat["tiles_instantiated_total"].push_back(sums["tiles_instantiated"]);
-      per_repeat["tiles_evicted_total"].push_back(sums["tiles_evicted"]);
-      per_repeat["tile_cache_max"].push_back(tile_cache_max);
-      if (sums["tile_queries"] > 0)
-        per_repeat["tile_prediction_failure_share"].push_back(sums["tile_prediction_failures"] / sums["tile_queries"]);
-      if (sums["tiles_instantiated"] > 0)
-        per_repeat["instantiate_ms_per_tile"].push_back(sums["instantiate_ms"] / sums["tiles_instantiated"]);
+      // Figures derived from two counters' sums over the run.
+      const double tile_queries = sum_of(sums, "tile_queries"), instantiated = sum_of(sums, "tiles_instantiated");
+      const double nodes = sum_of(sums, "nodes_visited");
+      if (tile_queries > 0)
+        per_repeat["tile_prediction_failure_share"].push_back(sum_of(sums, "tile_prediction_failures") / tile_queries);
+      if (instantiated > 0)
+        per_repeat["instantiate_ms_per_tile"].push_back(sum_of(sums, "instantiate_ms") / instantiated);
+      if (nodes > 0) per_repeat["cpu_us_per_node"].push_back(1e3 * sum_of(sums, "cpu_ms") / nodes);
       if (r.repeat == 0) a.memory = r.memory;
       if (a.first_miss.empty()) a.first_miss = r.first_miss;
-      if (sums["nodes_visited"] > 0) per_repeat["cpu_us_per_node"].push_back(1e3 * sums["cpu_ms"] / sums["nodes_visited"]);
       // A view of a split-screen run compares with the same view of the baseline.
       const std::size_t view_at = r.name.find(" [view ");
       const std::string view = view_at == std::string::npos ? "" : r.name.substr(view_at);
@@ -555,12 +542,16 @@ std::vector<AlgorithmSummary> summarize_runs(std::span<const AlgorithmRun> runs)
       const bool tiled_run = mean_ms.count({r.repeat, std::string(vfc_baseline(true)) + view}) > 0;
       ratio(std::string(vfc_baseline(tiled_run)).c_str(), "ratio_to_vfc");
       ratio("oracle", "ratio_to_oracle");
-      a.missed_objects = std::max(a.missed_objects, missed);
-      a.truth_object_frames = std::max(a.truth_object_frames, truth);
+      // Correctness: the worst repeat's.
       a.frames_with_misses = std::max(a.frames_with_misses, frames_missing);
-      a.wrong_pixels = std::max(a.wrong_pixels, wrong);
       a.worst_frame_wrong_pixels = std::max(a.worst_frame_wrong_pixels, worst);
       a.longest_miss_frames = std::max(a.longest_miss_frames, r.longest_miss_frames);
+    }
+    for (std::size_t c = 0; c < counters.size(); ++c) {
+      const std::vector<double>& v = counter_repeats[c];
+      if (v.empty()) continue;
+      set_summary(counters[c], a,
+                  counters[c].repeats == Combine::max ? *std::max_element(v.begin(), v.end()) : median_of(v));
     }
     const auto med = [&](const char* key) {
       const auto it = per_repeat.find(key);
@@ -569,41 +560,8 @@ std::vector<AlgorithmSummary> summarize_runs(std::span<const AlgorithmRun> runs)
     a.frame_ms = {med("mean"), med("median"), med("p95"), med("max")};
     a.ratio_to_vfc = med("ratio_to_vfc");
     a.ratio_to_oracle = med("ratio_to_oracle");
-    a.queries_per_frame = med("queries");
-    a.multiqueries_per_frame = med("multiqueries");
-    a.failed_multiqueries_per_frame = med("failed_multiqueries");
-    a.query_batches_per_frame = med("query_batches");
-    a.capped_share = med("capped");
-    a.over_cap_per_frame = med("over_cap");
-    a.result_age_frames = med("result_age");
-    a.revealed_per_frame = med("revealed");
-    a.state_changes_per_frame = med("state_changes");
-    a.render_flushes_per_frame = med("render_flushes");
-    a.draw_calls_per_frame = med("draw_calls");
-    a.triangles_per_frame = med("triangles");
-    a.objects_rendered_per_frame = med("objects_rendered");
-    a.conditional_objects_per_frame = med("conditional_objects");
-    a.conditional_skipped_per_frame = med("conditional_skipped");
-    a.stalled_per_frame = med("stalled");
-    a.nodes_visited_per_frame = med("nodes_visited");
-    a.extra_objects_per_frame = med("extra_objects");
-    a.wait_ms_per_frame = med("wait_ms");
-    a.blocking_waits_per_frame = med("blocking_waits");
-    a.flushes_per_frame = med("flushes");
-    a.cpu_ms_per_frame = med("cpu_ms");
-    a.gpu_ms_per_frame = med("gpu_ms");
-    a.model_ms_per_frame = med("model_ms");
     a.cpu_us_per_node = med("cpu_us_per_node");
-    a.kernel_ms_per_frame = med("kernel_ms");
-    a.minor_faults_per_frame = med("minor_faults");
-    a.major_faults_per_frame = med("major_faults");
-    a.tiles_rendered_per_frame = med("tiles_rendered");
-    a.tile_queries_per_frame = med("tile_queries");
-    a.tile_postponed_per_frame = med("tile_postponed");
     a.tile_prediction_failure_share = med("tile_prediction_failure_share");
-    a.tiles_instantiated = med("tiles_instantiated_total");
-    a.tiles_evicted = med("tiles_evicted_total");
-    a.tile_cache_max = med("tile_cache_max");
     a.instantiate_ms_per_tile = med("instantiate_ms_per_tile");
     out.push_back(std::move(a));
   }
@@ -619,43 +577,6 @@ std::vector<const AlgorithmSummary*> verification_failures(const BenchResult& re
 }
 
 namespace {
-
-// Adds one view's figures of a split-screen frame to the frame's.
-void add_view(FrameStats& sum, const FrameStats& v) {
-  sum.frame_ms += v.frame_ms;
-  sum.cpu_ms += v.cpu_ms;
-  sum.wait_ms += v.wait_ms;
-  sum.gpu_ms += v.gpu_ms;
-  sum.model_ms += v.model_ms;
-  sum.kernel_ms += v.kernel_ms;
-  sum.minor_faults += v.minor_faults;
-  sum.major_faults += v.major_faults;
-  sum.nodes_visited += v.nodes_visited;
-  sum.multiqueries += v.multiqueries;
-  sum.failed_multiqueries += v.failed_multiqueries;
-  sum.query_batches += v.query_batches;
-  sum.capped = std::max(sum.capped, v.capped);
-  sum.over_cap += v.over_cap;
-  sum.revealed += v.revealed;
-  sum.result_age += v.result_age;  // divided by the views at the end
-  sum.queries += v.queries;
-  sum.query_boxes += v.query_boxes;
-  sum.state_changes += v.state_changes;
-  sum.blocking_waits += v.blocking_waits;
-  sum.flushes += v.flushes;
-  sum.material_changes += v.material_changes;
-  sum.render_flushes += v.render_flushes;
-  sum.draw_calls += v.draw_calls;
-  sum.triangles += v.triangles;
-  sum.objects_rendered += v.objects_rendered;
-  sum.conditional_objects += v.conditional_objects;
-  sum.conditional_skipped += v.conditional_skipped;
-  sum.stalled += v.stalled;
-  sum.truth_objects += v.truth_objects;
-  sum.missed_objects += v.missed_objects;
-  sum.wrong_pixels += v.wrong_pixels;
-  sum.extra_objects += v.extra_objects;
-}
 
 // The frame of the path warm-up frame `w` runs: the warm-up frames are
 // spread over the path, so each algorithm sees its whole length once.
@@ -733,7 +654,7 @@ void run_split_screen(Session& session, const std::string& name, const BenchConf
       add_view(sum, s);
       each[std::size_t(k)].frames.push_back(s);
     }
-    sum.result_age /= double(views);
+    finish_views(sum, views);
     whole.frames.push_back(sum);
     if ((f + 1) % kMemorySampleFrames == 0) whole.memory.push_back(session.memory_sample(f + 1));
     if (progress) progress(label, f, config.frames, false);

@@ -1,5 +1,7 @@
 #include "occull/report.hpp"
 
+#include "occull/counters.hpp"
+
 #include "occull/error.hpp"
 #include "report_internal.hpp"
 #include "svg_chart.hpp"
@@ -246,49 +248,24 @@ nlohmann::ordered_json detail::bench_json(const BenchResult& r) {
                      {"ratio_to_vfc", a.ratio_to_vfc > 0 ? ordered_json(a.ratio_to_vfc) : ordered_json()},
                      {"ratio_to_oracle",
                       a.ratio_to_oracle > 0 ? ordered_json(a.ratio_to_oracle) : ordered_json()},
-                     {"queries_per_frame", a.queries_per_frame},
-                     {"multiqueries_per_frame", a.multiqueries_per_frame},
-                     {"failed_multiqueries_per_frame", a.failed_multiqueries_per_frame},
-                     {"query_batches_per_frame", a.query_batches_per_frame},
-                     {"capped_share", a.capped_share},
-                     {"over_cap_per_frame", a.over_cap_per_frame},
-                     {"result_age_frames", a.result_age_frames},
-                     {"revealed_per_frame", a.revealed_per_frame},
-                     {"state_changes_per_frame", a.state_changes_per_frame},
-                     {"render_flushes_per_frame", a.render_flushes_per_frame},
-                     {"draw_calls_per_frame", a.draw_calls_per_frame},
-                     {"triangles_per_frame", a.triangles_per_frame},
-                     {"objects_rendered_per_frame", a.objects_rendered_per_frame},
-                     {"conditional_objects_per_frame", a.conditional_objects_per_frame},
-                     {"conditional_skipped_per_frame", a.conditional_skipped_per_frame},
-                     {"stalled_per_frame", a.stalled_per_frame},
-                     {"nodes_visited_per_frame", a.nodes_visited_per_frame},
-                     {"extra_objects_per_frame", a.extra_objects_per_frame},
-                     {"missed_objects", a.missed_objects},
+                     {"cpu_us_per_node", a.cpu_us_per_node},
+                     {"tile_prediction_failure_share", a.tile_prediction_failure_share},
+                     {"instantiate_ms_per_tile", a.instantiate_ms_per_tile},
                      {"frames_with_misses", a.frames_with_misses},
-                     {"wrong_pixels", a.wrong_pixels},
                      {"worst_frame_wrong_pixels", a.worst_frame_wrong_pixels},
                      {"longest_miss_frames", a.longest_miss_frames},
-                     {"truth_object_frames", a.truth_object_frames},
-                     {"wait_ms_per_frame", a.wait_ms_per_frame},
-                     {"blocking_waits_per_frame", a.blocking_waits_per_frame},
-                     {"flushes_per_frame", a.flushes_per_frame},
-                     {"cpu_ms_per_frame", a.cpu_ms_per_frame},
-                     {"gpu_ms_per_frame", a.gpu_ms_per_frame},
-                     {"cpu_us_per_node", a.cpu_us_per_node},
-                     {"kernel_ms_per_frame", a.kernel_ms_per_frame},
-                     {"minor_faults_per_frame", a.minor_faults_per_frame},
-                     {"major_faults_per_frame", a.major_faults_per_frame},
-                     {"model_ms_per_frame", r.modelled ? ordered_json(a.model_ms_per_frame) : ordered_json()},
-                     {"tiles_rendered_per_frame", a.tiles_rendered_per_frame},
-                     {"tile_queries_per_frame", a.tile_queries_per_frame},
-                     {"tile_postponed_per_frame", a.tile_postponed_per_frame},
-                     {"tile_prediction_failure_share", a.tile_prediction_failure_share},
-                     {"tiles_instantiated", a.tiles_instantiated},
-                     {"tiles_evicted", a.tiles_evicted},
-                     {"tile_cache_max", a.tile_cache_max},
-                     {"instantiate_ms_per_tile", a.instantiate_ms_per_tile},
                      {"first_miss", a.first_miss.empty() ? ordered_json() : ordered_json(a.first_miss)}});
+    for (const Counter& c : frame_counters()) {
+      if (c.key.empty()) continue;
+      ordered_json value;  // null for a modelled figure of a run without --model
+      if (!c.modelled || r.modelled)
+        std::visit(
+            [&](auto member) {
+              if constexpr (!std::is_same_v<decltype(member), std::monostate>) value = a.*member;
+            },
+            c.summary);
+      algos.back()[std::string(c.key)] = value;
+    }
     ordered_json memory = ordered_json::array();
     for (const MemorySample& m : a.memory)
       memory.push_back({{"frame", m.frame}, {"rss_mb", m.rss_mb}, {"gpu_mb", m.gpu_mb}});
@@ -303,27 +280,24 @@ std::string detail::ratio_text(double r) { return r > 0 ? fmt::format("{:.2f}", 
 void write_json(const BenchResult& r, std::ostream& out) { out << detail::bench_json(r).dump(2) << "\n"; }
 
 void write_csv(const BenchResult& r, std::ostream& out) {
-  out << "algorithm,repeat,frame,frame_ms,cpu_ms,wait_ms,gpu_ms,queries,query_boxes,multiqueries,"
-         "failed_multiqueries,query_batches,state_changes,material_changes,render_flushes,"
-         "draw_calls,triangles,objects_rendered,nodes_visited,truth_objects,missed_objects,"
-         "wrong_pixels,extra_objects,blocking_waits,model_ms,kernel_ms,minor_faults,major_faults,flushes,"
-         "capped,over_cap,result_age,revealed,conditional_objects,conditional_skipped,stalled,"
-         "tiles_rendered,tile_queries,tile_postponed,tile_prediction_failures,tiles_instantiated,tiles_evicted,"
-         "tile_cache,instantiate_ms\n";
+  const std::span<const Counter> counters = frame_counters();
+  out << "algorithm,repeat,frame";
+  for (const Counter& c : counters) out << ',' << c.name;
+  out << '\n';
+  std::string row;
   for (const AlgorithmRun& run : r.runs) {
     for (std::size_t k = 0; k < run.frames.size(); ++k) {
-      const FrameStats& f = run.frames[k];
-      out << fmt::format("{},{},{},{:.4f},{:.4f},{:.4f},{:.4f},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},"
-                         "{:.4f},{:.4f},{},{},{},{},{},{:.3f},{},{},{},{},{},{},{},{},{},{},{},{:.4f}\n",
-                         run.name, run.repeat, k, f.frame_ms, f.cpu_ms, f.wait_ms, f.gpu_ms, f.queries,
-                         f.query_boxes, f.multiqueries, f.failed_multiqueries, f.query_batches,
-                         f.state_changes, f.material_changes, f.render_flushes, f.draw_calls,
-                         f.triangles, f.objects_rendered, f.nodes_visited, f.truth_objects,
-                         f.missed_objects, f.wrong_pixels, f.extra_objects, f.blocking_waits, f.model_ms,
-                         f.kernel_ms, f.minor_faults, f.major_faults, f.flushes, f.capped, f.over_cap,
-                         f.result_age, f.revealed, f.conditional_objects, f.conditional_skipped, f.stalled,
-                         f.tiles_rendered, f.tile_queries, f.tile_postponed, f.tile_prediction_failures,
-                         f.tiles_instantiated, f.tiles_evicted, f.tile_cache, f.instantiate_ms);
+      row = fmt::format("{},{},{}", run.name, run.repeat, k);
+      for (const Counter& c : counters)
+        std::visit(
+            [&](auto member) {
+              if (c.decimals < 0)
+                fmt::format_to(std::back_inserter(row), ",{}", run.frames[k].*member);
+              else
+                fmt::format_to(std::back_inserter(row), ",{:.{}f}", double(run.frames[k].*member), c.decimals);
+            },
+            c.frame);
+      out << row << '\n';
     }
   }
 }
@@ -409,7 +383,17 @@ std::vector<std::string> write_report(const BenchResult& r, const std::string& d
         "objects* were rendered without being visible (the culling's inefficiency).\n\n";
   md += "![frame time per frame](frame_ms.svg)\n\n![queries per frame](queries.svg)\n\n"
         "![triangles per frame](triangles.svg)\n\n";
-  md += "Raw data: [results.json](results.json), [frames.csv](frames.csv).\n";
+  md += "Raw data: [results.json](results.json), [frames.csv](frames.csv).\n\n";
+  md += "## What each frame counts\n\nOne column of frames.csv per counter; the summary's JSON key says how the "
+        "run's frames and the repeats reduce it.\n\n| frames.csv | unit | summary (results.json) | what it counts |\n"
+        "|---|---|---|---|\n";
+  for (const Counter& c : frame_counters()) {
+    const char* frames = c.frames == Combine::mean ? "mean per frame" : c.frames == Combine::sum ? "sum over frames"
+                                                                      : "largest frame";
+    const char* repeats = c.repeats == Combine::max ? "worst repeat" : "median over repeats";
+    md += fmt::format("| `{}` | {} | {} | {} |\n", c.name, c.unit,
+                      c.key.empty() ? std::string("-") : fmt::format("`{}`: {}, {}", c.key, frames, repeats), c.help);
+  }
   write("report.md", md);
   return written;
 }
