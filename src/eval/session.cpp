@@ -1,0 +1,284 @@
+// Session: the device and the scene for a run of frames (scene, BVH, GL
+// context, renderer, stall guard, logger, watchdog), the cullers made for
+// it, the hardware profile, paths and the timed frame itself.
+#include "occull/harness.hpp"
+
+#include "invariants.hpp"
+#include "oracle.hpp"
+#include "watchdog.hpp"
+#include "occull/counters.hpp"
+#include "occull/error.hpp"
+#include "occull/frame_log.hpp"
+#include "occull/gl/calibrate.hpp"
+#include "occull/process.hpp"
+#include "occull/profile_io.hpp"
+
+#include <fmt/format.h>
+#include <glm/gtc/matrix_transform.hpp>
+
+#include <chrono>
+#include <cmath>
+
+namespace occull {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double ms_between(Clock::time_point a, Clock::time_point b) {
+  return std::chrono::duration<double, std::milli>(b - a).count();
+}
+
+SceneBundle timed_make_scene(std::string_view spec, double& ms) {
+  const auto t0 = Clock::now();
+  SceneBundle b = make_scene(spec);
+  ms = ms_between(t0, Clock::now());
+  return b;
+}
+
+}  // namespace
+
+// The scene first: a bad spec is reported before any GL work.
+Session::Session(std::string_view scene_spec, const gl::RendererOptions& renderer_options,
+                 const BvhOptions& bvh_options, const gl::ContextOptions& context_options)
+    : scene_spec_(scene_spec), bundle_(timed_make_scene(scene_spec, scene_build_ms_)),
+      context_options_(context_options) {
+  const auto t0 = Clock::now();
+  // A tiled world has no global hierarchy: its cullers keep one BVH
+  // instance per tile (occull/tiles.hpp).
+  bvh_ = bundle_.world ? Bvh::build(std::span<const Aabb>{}, std::span<const std::uint32_t>{})
+                       : Bvh::build(bundle_.scene, bvh_options);
+  bvh_build_ms_ = ms_between(t0, Clock::now());
+  if (bundle_.world && float(renderer_options.width) > TiledWorld::kMaxAspect * float(renderer_options.height))
+    throw InputError(fmt::format("{}: a {}x{} viewport is wider than {}:1, the widest a tiled world's window of "
+                                 "placed tiles covers (occull::TiledWorld::kMaxAspect)",
+                                 scene_spec, renderer_options.width, renderer_options.height,
+                                 TiledWorld::kMaxAspect));
+  context_ = gl::Context::create(context_options_);
+  device_ = context_->info();
+  renderer_options_ = renderer_options;
+  renderer_ = std::make_unique<gl::Renderer>(bundle_.scene, renderer_options);
+  set_watchdog(kWatchdogSeconds);
+}
+
+void Session::set_watchdog(double seconds) {
+  if (!(seconds >= 0.0) || !std::isfinite(seconds))
+    throw InputError(fmt::format("watchdog {} s: must be a number of seconds >= 0 (0: off)", seconds));
+  watchdog_ = std::make_unique<detail::Watchdog>(seconds);
+}
+
+void Session::set_stall_guard(double timeout_ms) {
+  if (!(timeout_ms >= 0.0) || !std::isfinite(timeout_ms))
+    throw InputError(fmt::format("stall guard {} ms: must be a number of milliseconds >= 0 (0: off)", timeout_ms));
+  stall_guard_ms_ = timeout_ms;
+  logger_.reset();  // it wraps what backend() was
+  guard_ = timeout_ms > 0.0 ? std::make_unique<StallGuard>(*renderer_, timeout_ms) : nullptr;
+}
+
+Backend& Session::backend() noexcept {
+  if (guard_) return *guard_;
+  return *renderer_;
+}
+
+void Session::reset_renderer() {
+  logger_.reset();
+  guard_.reset();
+  renderer_.reset();
+  retired_.reset();  // idle since the previous replacement
+  retired_ = std::move(context_);
+  context_ = gl::Context::create(context_options_);
+  renderer_ = std::make_unique<gl::Renderer>(bundle_.scene, renderer_options_);
+  set_stall_guard(stall_guard_ms_);
+}
+
+Session::~Session() {
+  logger_.reset();
+  guard_.reset();     // reads the queries it gave up on
+  renderer_.reset();  // GL objects go before the context
+  context_.reset();
+  retired_.reset();
+}
+
+const CameraPath& Session::path(std::string_view name) {
+  if (name.empty()) return bundle_.paths.front();
+  if (name.rfind("file:", 0) == 0) {
+    CameraPath p = read_path_file(std::string(name.substr(5)));
+    for (const CameraPath& known : bundle_.paths)
+      if (known.name() == p.name()) return known;
+    bundle_.paths.push_back(std::move(p));
+    return bundle_.paths.back();
+  }
+  return bundle_.path(name);
+}
+
+View Session::view_at(const CameraPath& path, int k, int frames) const {
+  return make_view(path.sample(frame_time(path, k, frames)), bundle_.lens, renderer_->width(),
+                   renderer_->height());
+}
+
+FrameStats Session::run_frame(Culler& culler, const View& view, double time_s, FrameLog* log) {
+  const auto step = watchdog_->step(fmt::format("a culler's frame at {:.3f} s of the path", time_s));
+  advance_scene(time_s);
+  if (bundle_.world) bundle_.world->follow(bundle_.scene, view.eye);
+  const ProcessUsage u0 = process_usage();
+  const auto t0 = Clock::now();
+  if (!bundle_.world) bvh_.refit(bundle_.scene);
+  renderer_->begin_frame(view);
+  if (log && !logger_) logger_ = std::make_unique<LoggingBackend>(this->backend());
+  if (logger_) logger_->log_into(log);
+  Backend& backend = log ? static_cast<Backend&>(*logger_) : this->backend();
+  const BackendStats before = backend.stats();
+  const auto c0 = Clock::now();
+  FrameStats s = culler.render_frame(view, backend);
+  const auto c1 = Clock::now();
+  if (logger_) logger_->log_into(nullptr);  // `log` is this frame's only
+  const BackendStats during = backend.stats() - before;
+  context_->check("a culler's frame");  // before end_frame's own glGetError, which knows less
+  s.gpu_ms = renderer_->end_frame();
+  const auto t1 = Clock::now();
+  const ProcessUsage u1 = process_usage();
+  const BackendStats d = backend.stats() - before;
+  s.minor_faults = u1.minor_faults - u0.minor_faults;
+  s.major_faults = u1.major_faults - u0.major_faults;
+  s.kernel_ms = u1.kernel_ms - u0.kernel_ms;
+  s.frame_ms = ms_between(t0, t1);
+  s.cpu_ms = std::max(0.0, ms_between(c0, c1) - during.backend_ms);
+  copy_backend_counters(d, s);
+  context_->check("the end of a frame");
+  culler.frame_finished(s);
+  return s;
+}
+
+void Session::set_depth(DepthMode depth) {
+  if (depth == DepthMode::reversed && bundle_.world)
+    throw InputError(fmt::format("{}: --depth reversed has an infinite far plane, and a tiled world's window of tiles "
+                                 "is sized by the lens's far plane; use --depth standard there",
+                                 scene_spec_));
+  bundle_.lens.depth = depth;
+}
+
+void Session::set_engine_moves(double fraction) {
+  if (!(fraction >= 0.0 && fraction <= 1.0))
+    throw InputError(fmt::format("engine moves {}: must be a fraction of the objects in [0, 1]", fraction));
+  if (bundle_.world && fraction > 0.0)
+    throw InputError(fmt::format("{}: a tiled world places its own objects; engine moves are for other scenes",
+                                 scene_spec_));
+  for (std::size_t i = 0; i < engine_moved_.size(); ++i)  // back where they stood
+    bundle_.scene.set_transform(engine_moved_[i], engine_home_[i]);
+  engine_moved_.clear();
+  engine_home_.clear();
+  if (fraction <= 0.0) return;
+  const auto every = std::max<ObjectId>(1, ObjectId(std::lround(1.0 / fraction)));
+  for (ObjectId id = 0; id < bundle_.scene.objects().size(); id += every)
+    if (bundle_.scene.alive(id) && !bundle_.scene.object(id).dynamic()) {
+      engine_moved_.push_back(id);
+      engine_home_.push_back(bundle_.scene.object(id).transform);
+    }
+}
+
+void Session::advance_scene(double time_s) {
+  bundle_.scene.update(time_s);
+  for (std::size_t i = 0; i < engine_moved_.size(); ++i) {
+    const double angle = time_s * (2.0 * 3.14159265358979 / 4.0) + 0.7 * double(i);
+    const glm::vec3 offset(float(std::cos(angle)), 0.0f, float(std::sin(angle)));
+    bundle_.scene.set_transform(engine_moved_[i], glm::translate(glm::mat4(1.0f), offset) * engine_home_[i]);
+  }
+}
+
+void Session::release(Culler& culler) { culler.release(backend()); }
+
+void Session::check_queries_returned(std::string_view who) const {
+  const std::size_t abandoned = guard_ ? guard_->abandoned() : 0;
+  const std::size_t in_flight = renderer_->queries_in_flight();
+  if (in_flight > abandoned)
+    detail::invariant_violated({scene_spec_, std::string(who), 0}, "queries-returned",
+                               fmt::format("{} queries still in flight after the run's cullers were released ({} of "
+                                           "them given up on by the stall guard)",
+                                           in_flight, abandoned));
+}
+
+std::unique_ptr<Culler> Session::make(std::string_view spec, const Options& options,
+                                      const std::function<void(const std::string&)>& progress) {
+  const AlgorithmSpec a = parse_algorithm_spec(spec, options);
+  if (a.name == "oracle") return std::make_unique<detail::OracleCuller>(bundle_.scene);
+  return make_culler(a.name, index(), a.options, culler_context(progress));
+}
+
+CullerContext Session::culler_context(const std::function<void(const std::string&)>& progress) {
+  CullerContext context;  // nohc: the calibrated profile, unless an option names a file
+  context.nohc_profile_source = [this, progress]() -> const HardwareProfile& { return hardware_profile(progress); };
+  return context;
+}
+
+std::string Session::renderer_key() const { return device_.renderer + " | " + device_.version; }
+
+std::string Session::hardware_profile_path() const { return default_profile_path(renderer_key()); }
+
+const HardwareProfile& Session::hardware_profile(const std::function<void(const std::string&)>& progress) {
+  if (profile_) return *profile_;
+  const std::string path = hardware_profile_path();
+  profile_ = load_profile(path);
+  if (profile_ && profile_->renderer == renderer_key()) return *profile_;
+  if (progress) progress("calibrating the hardware cost model (a few seconds)");
+  gl::CalibrationOptions co;
+  co.repeats = 3;  // a first-use calibration stays within a few seconds
+  co.width = renderer_->width();
+  co.height = renderer_->height();
+  gl::CalibrationResult cal = gl::calibrate(co, progress);
+  cal.profile.renderer = renderer_key();
+  save_profile(cal.profile, path);
+  profile_ = cal.profile;
+  return *profile_;
+}
+
+double Session::predicted_frame_ms(const View& view) {
+  const HardwareProfile& hw = hardware_profile();
+  const Scene& scene = bundle_.scene;
+  const double pixels = double(view.width) * double(view.height);
+  double ms = 0.0;
+  for (ObjectId id : renderer_->frame_objects()) {
+    const Object& o = scene.object(id);
+    NodeCost c;
+    c.draws = 1;
+    c.triangles = o.triangles;
+    c.shading_cost = scene.material(o.material).shading_cost;
+    c.c_bb = projected_area(o.bounds, view.view_proj, view.width, view.height) / pixels;
+    c.r_cov = coverage_ratio(scene.object_surface_area(id), o.bounds.surface_area());
+    ms += render_time(hw, c, view.width, view.height);
+  }
+  const auto boxes = renderer_->frame_query_boxes();
+  std::size_t next = 0;
+  for (std::uint32_t n : renderer_->frame_query_sizes()) {
+    double covered = 0.0;
+    for (std::uint32_t i = 0; i < n; ++i)
+      covered += projected_area(boxes[next + i], view.view_proj, view.width, view.height) / pixels;
+    next += n;
+    ms += query_time(hw, covered, view.width, view.height);
+  }
+  return ms;
+}
+
+FrameStats Session::run_path_frame(Culler& culler, const CameraPath& path, int k, int frames,
+                                   const std::vector<FrameTruth>* truth) {
+  if (auto* oracle = dynamic_cast<detail::OracleCuller*>(&culler)) {
+    if (!truth) throw InputError("the oracle needs ground truth: run it with verification on");
+    std::vector<ObjectId> visible;
+    visible.reserve((*truth)[std::size_t(k)].visible.size());
+    for (const auto& t : (*truth)[std::size_t(k)].visible) visible.push_back(t.id);
+    if (hooks_.oracle_objects) hooks_.oracle_objects(visible);
+    oracle->set_visible(std::move(visible));
+  }
+  return run_frame(culler, view_at(path, k, frames), frame_time(path, k, frames));
+}
+
+MemorySample Session::memory_sample(int frame) const {
+  const MemoryUsage m = memory_usage();
+  return {frame, double(m.resident_bytes) / (1 << 20), double(renderer_->resources().buffer_bytes) / (1 << 20)};
+}
+
+std::string Session::describe_object(ObjectId id) const {
+  if (bundle_.world) return bundle_.world->describe(id);
+  if (id >= bundle_.scene.objects().size()) return fmt::format("object {} (not in the scene)", id);
+  return fmt::format("object {} (mesh {})", id, bundle_.scene.object(id).mesh);
+}
+
+}  // namespace occull

@@ -1,0 +1,119 @@
+// Ground truth and verification: the truth pass of a frame with its
+// invariants, and each culler frame checked against it.
+#include "occull/harness.hpp"
+
+#include "invariants.hpp"
+#include "oracle.hpp"
+#include "watchdog.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+
+namespace occull {
+
+std::vector<ObjectId> check_frame(std::span<const gl::Renderer::ObjectPixels> truth,
+                                  std::span<const ObjectId> rendered, std::size_t object_count,
+                                  FrameStats& stats) {
+  std::vector<std::uint8_t> drawn(object_count, 0);
+  for (ObjectId id : rendered) drawn[id] = 1;
+  std::vector<ObjectId> missed;
+  stats.truth_objects = std::uint32_t(truth.size());
+  stats.missed_objects = 0;
+  stats.wrong_pixels = 0;
+  std::size_t rendered_and_visible = 0;
+  for (const auto& t : truth) {
+    if (drawn[t.id]) {
+      ++rendered_and_visible;
+    } else {
+      missed.push_back(t.id);
+      stats.wrong_pixels += t.pixels;
+    }
+  }
+  stats.missed_objects = std::uint32_t(missed.size());
+  const auto distinct = std::size_t(std::count(drawn.begin(), drawn.end(), std::uint8_t(1)));
+  stats.extra_objects = std::uint32_t(distinct - rendered_and_visible);
+  return missed;
+}
+
+std::vector<FrameTruth> Session::ground_truth(const CameraPath& path, int frames,
+                                              const ProgressFn& progress) {
+  std::vector<FrameTruth> truth;
+  truth.reserve(std::size_t(frames));
+  for (int k = 0; k < frames; ++k) {
+    truth.push_back(truth_at(path, k, frames));
+    if (progress) progress("ground truth", k, frames, false);
+  }
+  return truth;
+}
+
+FrameTruth Session::truth_at(const CameraPath& path, int k, int frames) {
+  advance_scene(frame_time(path, k, frames));
+  const View view = view_at(path, k, frames);
+  const detail::FrameLabel where{scene_spec_, path.name(), k};
+  if (bundle_.world) {
+    bundle_.world->follow(bundle_.scene, view.eye);
+    // The truth sees only the placed cells: the window must hold the frustum.
+    if (!bundle_.world->covers(view))
+      detail::invariant_violated(where, "window-covers-frustum",
+                                 fmt::format("the frustum reaches past the {} x {} cells placed around the eye",
+                                             2 * bundle_.world->radius() + 1, 2 * bundle_.world->radius() + 1));
+  }
+  return truth_of(view, where);
+}
+
+FrameTruth Session::truth_of(const View& view) { return truth_of(view, {scene_spec_, "(free camera)", 0}); }
+
+FrameTruth Session::truth_of(const View& view, const detail::FrameLabel& where) {
+  const Scene& scene = bundle_.scene;
+  const auto objects = scene.objects();
+  const auto step = watchdog_->step(fmt::format("ground-truth frame {} of path {}", where.frame, where.path));
+  std::vector<ObjectId> in_frustum, outside;
+  for (ObjectId id = 0; id < objects.size(); ++id)
+    if (view.frustum.classify(objects[id].bounds) != Containment::outside) in_frustum.push_back(id);
+  if (hooks_.truth_objects) hooks_.truth_objects(in_frustum);
+
+  FrameTruth t;
+  gl::Renderer::PassImages images;
+  t.visible = renderer_->visible_pixels(view, in_frustum, &images);
+  if (hooks_.truth_images) hooks_.truth_images(t.visible, images);
+  // The full scene, for comparison: every opaque object left out of the
+  // truth pass, drawn over its depth, must not pass a single sample.
+  std::vector<std::uint8_t> drawn(objects.size(), 0);
+  for (ObjectId id : in_frustum) drawn[id] = 1;
+  for (ObjectId id = 0; id < objects.size(); ++id)
+    if (!drawn[id] && scene.alive(id) && !scene.material(objects[id].material).translucent) outside.push_back(id);
+  const std::uint64_t outside_samples = renderer_->samples_in_front(view, outside);
+
+  context_->check("the ground truth");
+  std::sort(in_frustum.begin(), in_frustum.end());
+  detail::check_truth_in_frustum(where, t.visible, in_frustum);
+  detail::check_truth_covers_full_render(where, images.ids, images.depth, outside_samples);
+  detail::check_truth_not_empty(where, t.visible, images.ids, scene);
+  t.probes = std::uint32_t(detail::check_truth_probes(where, scene, view, in_frustum, images.depth,
+                                                       renderer_options_.cull_backfaces));
+  t.coverage = detail::depth_coverage(images.depth);
+  return t;
+}
+
+std::vector<ObjectId> Session::verify_frame(std::string_view name, const Culler& culler, const CameraPath& path,
+                                            int k, const FrameTruth& t, FrameStats& s) {
+  const detail::FrameLabel where{scene_spec_, path.name(), k};
+  std::vector<float> depth = renderer_->read_depth();
+  if (hooks_.frame_depth) hooks_.frame_depth(depth);
+  const Coverage frame = detail::depth_coverage(depth);
+  detail::check_frame_within_truth(where, std::string(name), t.coverage, frame);
+  if (dynamic_cast<const detail::OracleCuller*>(&culler))
+    detail::check_oracle_draws_truth(where, t.visible, renderer_->frame_objects(), t.coverage.depth_hash,
+                                     frame.depth_hash);
+  return check_frame(t.visible, renderer_->frame_objects(), bundle_.scene.objects().size(), s);
+}
+
+void MissRuns::add(const std::vector<ObjectId>& missed) {
+  for (ObjectId id : previous_)
+    if (!std::binary_search(missed.begin(), missed.end(), id)) run_[id] = 0;
+  for (ObjectId id : missed) longest_ = std::max(longest_, ++run_[id]);
+  previous_ = missed;
+}
+
+}  // namespace occull
