@@ -93,7 +93,7 @@ TEST(AutoCuller, SwitchesWhenTheBackendsCostsChange) {
   o.set("chcpp.backoff", "0");
   const auto culler = make_culler("auto", {scene, bvh}, o);
   const View view = make_view({{0, 0, 0}, 0, 0}, {60.0f, 0.1f, 200.0f}, 64, 64);
-  test::RecordingBackend backend;
+  test::ScriptedBackend backend;
   // A frame with queries costs `query_frame` ms, one without `plain_frame`.
   const auto fly = [&](double query_frame, double plain_frame, int frames) {
     int with_queries = 0;

@@ -84,7 +84,7 @@ TEST(Chcpp, NodesThatStayInvisibleShareMultiqueriesAndAFailedOneIsSplit) {
   std::vector<Aabb> visible;
   for (ObjectId i = 0; i < boxes.size(); ++i)
     if (!hidden(i)) visible.push_back(boxes[i]);
-  test::RecordingBackend backend;
+  test::ScriptedBackend backend;
   backend.visible_samples = visible_if_overlapping(&visible);
   const View view = make_view({{0, 0, 0}, 0, 0}, {90.0f, 0.1f, 500.0f}, 64, 64);
   std::uint64_t multiqueries = 0;
@@ -164,7 +164,7 @@ TEST(Jitter, NewlyVisibleLeavesAreNotReQueriedAllInOneFrame) {
     o.set("chcpp.virtual_leaf", "0");
     auto culler = make_culler("chcpp", {scene, bvh}, o);
     visible.clear();
-    test::RecordingBackend backend;
+    test::ScriptedBackend backend;
     backend.visible_samples = visible_if_overlapping(&visible);
     const View view = make_view({{0, 0, 0}, 0, 0}, {90.0f, 0.1f, 500.0f}, 64, 64);
     culler->render_frame(view, backend);  // frame 1: nothing visible
@@ -208,7 +208,7 @@ TEST(EyeInside, NodeAroundTheCameraIsNotQueried) {
   const Bvh bvh = Bvh::build(scene);
   for (const char* name : {"stopwait", "chc", "chcpp"}) {
     auto culler = make_culler(name, {scene, bvh});
-    test::RecordingBackend backend;
+    test::ScriptedBackend backend;
     backend.visible_samples = [](std::span<const Aabb>) { return std::uint64_t(0); };
     for (int f = 0; f < 3; ++f) culler->render_frame(kView, backend);
     EXPECT_TRUE(backend.queried.empty()) << name;
@@ -234,7 +234,7 @@ TEST(Conservative, HierarchicalCullersRenderEveryVisibleObjectEveryFrame) {
     const AlgorithmSpec a = parse_algorithm_spec(spec);
     auto culler = make_culler(a.name, {scene, bvh}, a.options);
     std::vector<Aabb> visible;
-    test::RecordingBackend backend;
+    test::ScriptedBackend backend;
     backend.visible_samples = visible_if_overlapping(&visible);
     for (int f = 0; f < 30; ++f) {
       visible.clear();
@@ -322,7 +322,7 @@ std::uint64_t queries_while_turning(const char* enter_p_min, bool all_visible) {
   o.set("chcpp.virtual_leaf", "0");
   o.set("chcpp.enter_p_min", enter_p_min);
   auto culler = make_culler("chcpp", {scene, bvh}, o);
-  test::RecordingBackend backend;
+  test::ScriptedBackend backend;
   if (!all_visible) backend.visible_samples = [](std::span<const Aabb>) { return std::uint64_t(0); };
   std::uint64_t queries = 0;
   for (int f = 0; f < 120; ++f) {

@@ -68,7 +68,7 @@ TEST(None, RendersEveryObject) {
   const Scene scene = scattered(50, 2);
   const Bvh bvh = Bvh::build(scene);
   auto culler = make_culler("none", {scene, bvh});
-  test::RecordingBackend backend;
+  test::ScriptedBackend backend;
   const View view = make_view({{0, 0, 0}, 0, 0}, {}, 64, 64);
   culler->render_frame(view, backend);
   EXPECT_EQ(backend.rendered.size(), 50u);
@@ -81,7 +81,7 @@ TEST(Vfc, RendersExactlyTheObjectsNotOutsideTheFrustum) {
   auto culler = make_culler("vfc", {scene, bvh});
   for (float yaw : {0.0f, 1.0f, 2.5f, -2.0f}) {
     const View view = make_view({{3, 1, -4}, yaw, 0.1f}, {60.0f, 0.1f, 80.0f}, 160, 90);
-    test::RecordingBackend backend;
+    test::ScriptedBackend backend;
     const FrameStats stats = culler->render_frame(view, backend);
     std::vector<ObjectId> expected;
     for (ObjectId id = 0; id < scene.objects().size(); ++id)
@@ -104,7 +104,7 @@ TEST(Vfc, RendersFrontToBackByNode) {
   o.max_leaf_objects = 1;
   const Bvh bvh = Bvh::build(scene, o);
   auto culler = make_culler("vfc", {scene, bvh});
-  test::RecordingBackend backend;
+  test::ScriptedBackend backend;
   culler->render_frame(make_view({{0, 0, 0}, 0, 0}, {60.0f, 0.1f, 500.0f}, 64, 64), backend);
   ASSERT_EQ(backend.rendered.size(), 32u);
   for (std::size_t i = 0; i < 32; ++i) EXPECT_EQ(backend.rendered[i], ObjectId(i));
@@ -132,7 +132,7 @@ TEST(MakeCuller, TakesSpecsWithOptionsAndAProfileInMemory) {
   CullerContext context;
   context.nohc_profile = &profile;
   auto nohc = make_culler("nohc:learn=off", {scene, bvh}, {}, context);
-  test::RecordingBackend backend;
+  test::ScriptedBackend backend;
   const View view = make_view({{0, 0, 0}, 0, 0}, {60.0f, 0.1f, 100.0f}, 64, 64);
   (void)nohc->render_frame(view, backend);
   EXPECT_EQ(nohc->drawn_objects().size(), 1u);

@@ -125,7 +125,7 @@ TEST_F(DebugViewGl, OccludedQueriesOfARealFrameShowWhereTheVerifierFoundNothing)
     stats = session.run_frame(*culler, session.view_at(path, i, frames), session.frame_time(path, i, frames),
                               i == k ? &log : nullptr);
   const View view = session.view_at(path, k, frames);
-  const auto drawn_span = session.renderer().frame_objects();
+  const auto drawn_span = session.recording().objects();
   const std::vector<ObjectId> drawn(drawn_span.begin(), drawn_span.end());
   const std::vector<std::uint8_t> frame = session.renderer().read_rgba();
   std::vector<ObjectId> truth;

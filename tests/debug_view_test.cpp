@@ -25,7 +25,7 @@ View front_view() { return make_view({{0, 0, 0}, 0, 0}, {60, 0.1f, 100}, 64, 36)
 }  // namespace
 
 TEST(FrameLog, LogsCallsInOrderWithAnswersAndConditionalDraws) {
-  test::RecordingBackend inner;
+  test::ScriptedBackend inner;
   inner.conditional = true;
   inner.visible_samples = [](std::span<const Aabb>) { return std::uint64_t(7); };
   FrameLog log;
@@ -54,7 +54,7 @@ TEST(FrameLog, LogsCallsInOrderWithAnswersAndConditionalDraws) {
 }
 
 TEST(FrameLog, AQueryOfAnEarlierFrameIsForwardedButNotLogged) {
-  test::RecordingBackend inner;
+  test::ScriptedBackend inner;
   const Aabb box{{0, 0, 0}, {1, 1, 1}};
   const QueryId old = inner.issue_query(std::span<const Aabb>(&box, 1));
   FrameLog log;
@@ -66,7 +66,7 @@ TEST(FrameLog, AQueryOfAnEarlierFrameIsForwardedButNotLogged) {
 }
 
 TEST(FrameLog, WithoutALogItOnlyForwardsAndANewLogStartsEmpty) {
-  test::RecordingBackend inner;
+  test::ScriptedBackend inner;
   LoggingBackend b(inner);
   const Aabb box{{0, 0, 0}, {1, 1, 1}};
   const QueryId q = b.issue_query(std::span<const Aabb>(&box, 1));  // not logged

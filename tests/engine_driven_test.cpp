@@ -41,7 +41,7 @@ TEST(EngineDrivenScene, EveryAlgorithmFollowsMovesAdditionsAndRemovals) {
     Options options;
     if (info.name == "nohc" || info.name == "auto") options.set("nohc.profile", profile.path());
     auto culler = make_culler(info.name, {scene, bvh}, options);
-    test::RecordingBackend backend;
+    test::ScriptedBackend backend;
     std::vector<Aabb> visible;
     backend.visible_samples = [&visible](std::span<const Aabb> boxes) {
       std::uint64_t samples = 0;
@@ -141,10 +141,10 @@ TEST(EngineDrivenScene, HierarchicalCullersKeepTheirStateAcrossARebuild) {
           for (int j = 0; j < 12; ++j) (void)place(-11.0f + 2.0f * float(i), -11.0f + 2.0f * float(j), -8.0f - 20.0f * float(layer));
       Bvh bvh = Bvh::build(scene);
       const auto answer = [visible](std::span<const Aabb> boxes) { return visible ? std::uint64_t(boxes.size()) : 0; };
-      const auto work = [](const test::RecordingBackend& b) { return b.queried.size() + b.rendered.size(); };
+      const auto work = [](const test::ScriptedBackend& b) { return b.queried.size() + b.rendered.size(); };
 
       auto culler = make_culler(name, {scene, bvh}, {}, context);
-      test::RecordingBackend backend;
+      test::ScriptedBackend backend;
       backend.visible_samples = answer;
       for (int frame = 0; frame < 8; ++frame) (void)culler->render_frame(view, backend);
       culler->release(backend);
@@ -152,13 +152,13 @@ TEST(EngineDrivenScene, HierarchicalCullersKeepTheirStateAcrossARebuild) {
       (void)place(0.0f, 0.0f, -300.0f);
       bvh.refit(scene);
       ASSERT_NE(bvh.generation(), generation) << "an object past the built count rebuilds the hierarchy";
-      test::RecordingBackend after;
+      test::ScriptedBackend after;
       after.visible_samples = answer;
       (void)culler->render_frame(view, after);
       culler->release(after);
 
       auto fresh = make_culler(name, {scene, bvh}, {}, context);
-      test::RecordingBackend first;
+      test::ScriptedBackend first;
       first.visible_samples = answer;
       (void)fresh->render_frame(view, first);
       fresh->release(first);

@@ -51,7 +51,7 @@ std::uint64_t behind_wall(std::span<const Aabb> boxes) {
   return samples;
 }
 
-std::size_t times_drawn(const test::RecordingBackend& b, ObjectId id) {
+std::size_t times_drawn(const test::ScriptedBackend& b, ObjectId id) {
   return std::size_t(std::count(b.rendered.begin(), b.rendered.end(), id));
 }
 
@@ -59,7 +59,7 @@ std::size_t times_drawn(const test::RecordingBackend& b, ObjectId id) {
 
 TEST(Grid, HidesAnOccludedCellFromTheFrameAfterItsQueryAndQueriesItAgainEachFrame) {
   Stage s;
-  test::RecordingBackend backend;
+  test::ScriptedBackend backend;
   auto culler = s.make();
   backend.visible_samples = behind_wall;
   for (int frame = 1; frame <= 4; ++frame) {
@@ -82,7 +82,7 @@ TEST(Grid, HidesAnOccludedCellFromTheFrameAfterItsQueryAndQueriesItAgainEachFram
 
 TEST(Grid, TheThesisLeavesCellsWithoutAnAnswerHidden) {
   Stage s;
-  test::RecordingBackend backend;
+  test::ScriptedBackend backend;
   auto culler = s.make({"grid.unknown=hidden", "grid.latency=1"});
   culler->render_frame(s.view, backend);
   EXPECT_TRUE(backend.rendered.empty());
@@ -93,7 +93,7 @@ TEST(Grid, TheThesisLeavesCellsWithoutAnAnswerHidden) {
 TEST(Grid, AHiddenCellWhoseQueryFindsItVisibleIsDrawnInTheFrameOfTheQueryWithLatencyZero) {
   for (int latency : {0, 1}) {
     Stage s;
-    test::RecordingBackend backend;
+    test::ScriptedBackend backend;
     auto culler = s.make({"grid.latency=" + std::to_string(latency)});
     backend.visible_samples = behind_wall;
     for (int frame = 1; frame <= 2; ++frame) culler->render_frame(s.view, backend);
@@ -113,7 +113,7 @@ TEST(Grid, AHiddenCellWhoseQueryFindsItVisibleIsDrawnInTheFrameOfTheQueryWithLat
 
 TEST(Grid, VisibleAnswersHoldForVisDurationFrames) {
   Stage s;
-  test::RecordingBackend backend;
+  test::ScriptedBackend backend;
   auto culler = s.make({"grid.vis_duration=5", "grid.vis_growth=0"});
   std::vector<std::size_t> per_frame;
   for (int frame = 1; frame <= 12; ++frame) {
@@ -130,7 +130,7 @@ TEST(Grid, VisibleAnswersHoldForVisDurationFrames) {
 
 TEST(Grid, CapsQueriesExceptForCellsThatWereVisible) {
   Stage s;
-  test::RecordingBackend backend;
+  test::ScriptedBackend backend;
   {
     // Without answers every cell is hidden: the cap holds.
     auto culler = s.make({"grid.cap=2", "grid.unknown=hidden"});
@@ -149,7 +149,7 @@ TEST(Grid, CapsQueriesExceptForCellsThatWereVisible) {
 
 TEST(Grid, DrawsAnObjectOncePerFrameOccludersFirst) {
   Stage s;
-  test::RecordingBackend backend;
+  test::ScriptedBackend backend;
   auto culler = s.make();
   for (int frame = 1; frame <= 3; ++frame) {
     backend.rendered.clear();
@@ -165,7 +165,7 @@ TEST(Grid, DrawsAnObjectOncePerFrameOccludersFirst) {
 
 TEST(Grid, CountsCappedFramesDeferredQueriesAndTheAgeOfItsAnswers) {
   Stage s;
-  test::RecordingBackend backend;
+  test::ScriptedBackend backend;
   std::size_t due = 0;  // cells due a query in the first frame: every non-empty one in view
   {
     auto culler = s.make({"grid.unknown=hidden"});
@@ -200,13 +200,13 @@ TEST(Grid, PrePassOfACellQueriedThisFrameIsConditionalOnItsQueryUnlessAnObjectLe
   const GridGeometry g = UniformGrid::of_scene(s.scene, 2.0f).geometry();
   ASSERT_EQ(g.cell_of(small.min), g.cell_of(small.max)) << "the test's object must lie in one cell";
 
-  const auto conditional_ids = [](const test::RecordingBackend& b) {
+  const auto conditional_ids = [](const test::ScriptedBackend& b) {
     std::vector<ObjectId> ids;
     for (const auto& [id, q] : b.rendered_conditionally) ids.push_back(id);
     return ids;
   };
   {
-    test::RecordingBackend backend;
+    test::ScriptedBackend backend;
     backend.conditional = true;
     auto culler = s.make();
     culler->render_frame(s.view, backend);
@@ -220,7 +220,7 @@ TEST(Grid, PrePassOfACellQueriedThisFrameIsConditionalOnItsQueryUnlessAnObjectLe
     EXPECT_EQ(times_drawn(backend, 0), 1u);
   }
   {
-    test::RecordingBackend backend;
+    test::ScriptedBackend backend;
     backend.conditional = true;
     auto culler = s.make({"grid.conditional=off"});
     culler->render_frame(s.view, backend);
@@ -228,7 +228,7 @@ TEST(Grid, PrePassOfACellQueriedThisFrameIsConditionalOnItsQueryUnlessAnObjectLe
     EXPECT_EQ(times_drawn(backend, 4), 1u);
   }
   {
-    test::RecordingBackend backend;  // no conditional rendering: drawn as usual
+    test::ScriptedBackend backend;  // no conditional rendering: drawn as usual
     auto culler = s.make();
     culler->render_frame(s.view, backend);
     EXPECT_EQ(times_drawn(backend, 4), 1u);
@@ -245,7 +245,7 @@ TEST(Grid, DrawsNoObjectOutsideTheFrustumThoughACellOfItMeetsTheFrustum) {
                      OccluderClass::never);
   s.bvh = Bvh::build(s.scene);
   ASSERT_EQ(s.view.frustum.classify(beside), Containment::outside);
-  test::RecordingBackend backend;
+  test::ScriptedBackend backend;
   auto culler = s.make();
   for (int frame = 1; frame <= 2; ++frame) {
     backend.rendered.clear();
@@ -353,7 +353,7 @@ TEST(GridViews, ViewsShareOneGridAndTheViewWhoseHiddenCellsComeIntoSightGetsTheL
   // other frame everything is visible), so re-queries of its hidden cells
   // find them visible again; in view 1 the wall stands.
   int frame = 0;
-  test::RecordingBackend flicker, steady;
+  test::ScriptedBackend flicker, steady;
   flicker.visible_samples = [&frame](std::span<const Aabb> boxes) {
     return frame % 2 == 0 ? std::uint64_t(boxes.size()) : behind_wall(boxes);
   };

@@ -52,7 +52,7 @@ std::map<std::string, std::vector<ObjectId>> render_with_every_culler(const Scen
   std::map<std::string, std::vector<ObjectId>> out;
   for (const auto& [name, options] : every_culler()) {
     auto culler = make_culler(name, {scene, bvh}, options);
-    test::RecordingBackend backend;
+    test::ScriptedBackend backend;
     for (int f = 0; f < frames; ++f) {
       backend.rendered.clear();
       culler->render_frame(view, backend);
@@ -157,7 +157,7 @@ TEST(Pathological, AMillionInstancesBuildABvhThatVfcCulls) {
   EXPECT_EQ(scene.objects().size(), 1000000u);
   EXPECT_GT(bvh.size(), 1000000u / BvhOptions{}.max_leaf_objects);
   auto culler = make_culler("vfc", {scene, bvh});
-  test::RecordingBackend backend;
+  test::ScriptedBackend backend;
   culler->render_frame(kView, backend);
   std::size_t in_frustum = 0;
   for (const Object& o : scene.objects()) in_frustum += kView.frustum.classify(o.bounds) != Containment::outside;

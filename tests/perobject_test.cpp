@@ -38,13 +38,13 @@ struct Stage {
 };
 
 // Queries whose (single) box is object `id`'s.
-std::size_t queries_of(const test::RecordingBackend& b, const Scene& scene, ObjectId id) {
+std::size_t queries_of(const test::ScriptedBackend& b, const Scene& scene, ObjectId id) {
   return std::size_t(std::count_if(b.queried.begin(), b.queried.end(), [&](const std::vector<Aabb>& q) {
     return q.size() == 1 && q[0] == scene.object(id).bounds;
   }));
 }
 
-std::size_t times_drawn(const test::RecordingBackend& b, ObjectId id) {
+std::size_t times_drawn(const test::ScriptedBackend& b, ObjectId id) {
   return std::size_t(std::count(b.rendered.begin(), b.rendered.end(), id));
 }
 
@@ -53,7 +53,7 @@ std::size_t times_drawn(const test::RecordingBackend& b, ObjectId id) {
 TEST(PerObject, OccludersArePrepassedFirstAndNeverQueried) {
   Stage s;
   auto culler = s.make();
-  test::RecordingBackend backend;
+  test::ScriptedBackend backend;
   for (int f = 0; f < 6; ++f) {
     backend.rendered.clear();
     culler->render_frame(s.view, backend);
@@ -66,7 +66,7 @@ TEST(PerObject, OccludersArePrepassedFirstAndNeverQueried) {
 TEST(PerObject, VisibleObjectIsRetestedOnlyEveryIntervalFrames) {
   Stage s;
   auto culler = s.make({"perobject.interval=5"});
-  test::RecordingBackend backend;  // everything visible, answers at once
+  test::ScriptedBackend backend;  // everything visible, answers at once
   for (int f = 0; f < 30; ++f) culler->render_frame(s.view, backend);
   // Tested in frames 1, 7, 13, 19, 25: a query, then 5 frames drawn untested.
   EXPECT_EQ(queries_of(backend, s.scene, 2), 5u);
@@ -76,7 +76,7 @@ TEST(PerObject, VisibleObjectIsRetestedOnlyEveryIntervalFrames) {
 TEST(PerObject, OccludedObjectIsDroppedOnceAnsweredAndRetestedEveryFrame) {
   Stage s;
   auto culler = s.make();
-  test::RecordingBackend backend;
+  test::ScriptedBackend backend;
   backend.visible_samples = [&](std::span<const Aabb> b) {
     return std::uint64_t(b[0] == s.scene.object(1).bounds ? 0 : 9);  // object 1 is hidden
   };
@@ -90,7 +90,7 @@ TEST(PerObject, PendingObjectIsDrawnOnlyWithRenderPending) {
   for (const bool render_pending : {true, false}) {
     Stage s;
     auto culler = s.make({std::string("perobject.render_pending=") + (render_pending ? "on" : "off")});
-    test::RecordingBackend backend;
+    test::ScriptedBackend backend;
     bool answered = false;
     backend.available = [&](QueryId) { return answered; };
     for (int f = 0; f < 3; ++f) culler->render_frame(s.view, backend);  // answers late
@@ -106,7 +106,7 @@ TEST(PerObject, PendingObjectIsDrawnOnlyWithRenderPending) {
 TEST(PerObject, ObjectNearTheEyeIsDrawnWithoutAQuery) {
   Stage s;
   auto culler = s.make();
-  test::RecordingBackend backend;
+  test::ScriptedBackend backend;
   backend.visible_samples = [](std::span<const Aabb>) { return std::uint64_t(0); };
   for (int f = 0; f < 4; ++f) culler->render_frame(s.view, backend);
   EXPECT_EQ(queries_of(backend, s.scene, 3), 0u);

@@ -42,7 +42,7 @@ Scene moving_boxes() {
 // the one it was first polled in, as on a busy device; result() still
 // answers) and say a box is visible when its hash says so, changing every
 // few frames.
-void make_slow_and_changing(test::RecordingBackend& backend, const int& frame) {
+void make_slow_and_changing(test::ScriptedBackend& backend, const int& frame) {
   auto first_poll = std::make_shared<std::map<QueryId, int>>();
   backend.available = [first_poll, &frame](QueryId q) { return first_poll->try_emplace(q, frame).first->second < frame; };
   backend.visible_samples = [&frame](std::span<const Aabb> boxes) {
@@ -55,8 +55,8 @@ void make_slow_and_changing(test::RecordingBackend& backend, const int& frame) {
 
 }  // namespace
 
-TEST(RecordingBackend, ReadingAQueryTwiceFailsLoudly) {
-  test::RecordingBackend backend;
+TEST(ScriptedBackend, ReadingAQueryTwiceFailsLoudly) {
+  test::ScriptedBackend backend;
   const Aabb box{{0, 0, 0}, {1, 1, 1}};
   const QueryId q = backend.issue_query(std::span<const Aabb>(&box, 1));
   EXPECT_EQ(backend.in_flight(), 1u);
@@ -66,8 +66,8 @@ TEST(RecordingBackend, ReadingAQueryTwiceFailsLoudly) {
   EXPECT_THROW((void)backend.result_available(q), std::logic_error);
 }
 
-TEST(RecordingBackend, AQueryOfAnotherDeviceFailsLoudly) {
-  test::RecordingBackend a(0), b(1000);
+TEST(ScriptedBackend, AQueryOfAnotherDeviceFailsLoudly) {
+  test::ScriptedBackend a(0), b(1000);
   const Aabb box{{0, 0, 0}, {1, 1, 1}};
   const QueryId q = a.issue_query(std::span<const Aabb>(&box, 1));
   EXPECT_THROW((void)b.result(q), std::logic_error);
@@ -92,7 +92,7 @@ TEST(QueryOwnership, EveryBvhAlgorithmHandsBackEveryQuery) {
     for (const auto& [k, v] : base.values())
       if (k.rfind(info.name + ".", 0) == 0 || info.name == "auto") options.set(k, v);
     auto culler = make_culler(info.name, {scene, bvh}, options);
-    test::RecordingBackend backend;
+    test::ScriptedBackend backend;
     int frame = 0;
     make_slow_and_changing(backend, frame);
     for (frame = 0; frame < 24; ++frame) {
@@ -122,7 +122,7 @@ TEST(QueryOwnership, EveryTiledWorldAlgorithmHandsBackEveryQuery) {
   for (const AlgorithmInfo& info : algorithms()) {
     if (info.harness_only || !runs_on(info, true)) continue;
     auto culler = make_culler(info.name, {bundle.scene, none, bundle.world.get()});
-    test::RecordingBackend backend;
+    test::ScriptedBackend backend;
     int frame = 0;
     make_slow_and_changing(backend, frame);
     // Tiles found visible stay predicted visible, so their late queries are

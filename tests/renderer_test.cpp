@@ -4,6 +4,7 @@
 #include "occull/error.hpp"
 #include "occull/gl/context.hpp"
 #include "occull/gl/renderer.hpp"
+#include "occull/recording_backend.hpp"
 #include "occull/harness.hpp"
 #include "test_util.hpp"
 
@@ -216,44 +217,50 @@ TEST_F(RendererTest, IdBufferHoldsTheVisibleObjects) {
 }
 
 // Conditional rendering. The box beside the wall, drawn on the condition of
-// the hidden box's query, must not reach the image nor the frame's record;
-// the hidden box, drawn on the visible query of the box beside, is drawn
-// (and recorded) but stays behind the wall. Both wait modes, with the
-// queries read before and after end_frame().
+// the hidden box's query, must not reach the image nor the frame's record
+// (a RecordingBackend over the renderer, settled by unread_result where the
+// query is still in flight at the frame's end); the hidden box, drawn on the
+// visible query of the box beside, is drawn (and recorded) but stays behind
+// the wall. Both wait modes, with the queries read before and after end_frame().
 TEST_F(RendererTest, ConditionalDrawsTakeEffectOnlyWhereTheirQueryPassed) {
   WallScene w;
   gl::Renderer r(w.scene, small());
-  ASSERT_TRUE(r.conditional_rendering());
+  RecordingBackend rec(r, w.scene);
+  ASSERT_TRUE(rec.conditional_rendering());
   r.set_write_ids(true);
   for (const ConditionalWait wait : {ConditionalWait::wait, ConditionalWait::no_wait}) {
     for (const bool read_before_end : {true, false}) {
       const std::string where = fmt::format("wait {}, read before end {}", int(wait), read_before_end);
       const BackendStats before = r.stats();
-      begin_with_wall(r, w);
+      r.begin_frame(w.view);
+      rec.start_frame();
+      const ObjectId wall[] = {WallScene::wall};
+      rec.render(wall);
       const ObjectId hidden[] = {WallScene::hidden}, beside[] = {WallScene::beside};
       const Aabb hidden_box[] = {w.scene.object(WallScene::hidden).bounds};
       const Aabb beside_box[] = {w.scene.object(WallScene::beside).bounds};
-      const QueryId qh = r.issue_query(hidden_box);
-      const QueryId qb = r.issue_query(beside_box);
+      const QueryId qh = rec.issue_query(hidden_box);
+      const QueryId qb = rec.issue_query(beside_box);
       // no_wait draws while a result is unknown: wait for both first.
-      for (int polls = 0; !(r.result_available(qh) && r.result_available(qb)); ++polls)
+      for (int polls = 0; !(rec.result_available(qh) && rec.result_available(qb)); ++polls)
         ASSERT_LT(polls, 1000000) << where;
-      r.render_conditional(beside, qh, wait);
-      r.render_conditional(hidden, qb, wait);
+      rec.render_conditional(beside, qh, wait);
+      rec.render_conditional(hidden, qb, wait);
       if (read_before_end) {
-        EXPECT_EQ(r.result(qh), 0u);
-        EXPECT_GT(r.result(qb), 0u);
+        EXPECT_EQ(rec.result(qh), 0u);
+        EXPECT_GT(rec.result(qb), 0u);
       }
       r.end_frame();
-      const std::set<ObjectId> drawn(r.frame_objects().begin(), r.frame_objects().end());
+      rec.finish_frame([&](QueryId q) { return r.unread_result(q); });
+      const std::set<ObjectId> drawn(rec.objects().begin(), rec.objects().end());
       EXPECT_EQ(drawn, (std::set<ObjectId>{WallScene::wall, WallScene::hidden})) << where;
       EXPECT_EQ(ids_in(r.read_ids()), (std::set<ObjectId>{WallScene::wall})) << where;
       const BackendStats d = r.stats() - before;
       EXPECT_EQ(d.conditional_objects, 2u) << where;
       EXPECT_EQ(d.conditional_skipped, 1u) << where;
       if (!read_before_end) {
-        EXPECT_EQ(r.result(qh), 0u);
-        EXPECT_GT(r.result(qb), 0u);
+        EXPECT_EQ(rec.result(qh), 0u);
+        EXPECT_GT(rec.result(qb), 0u);
       }
     }
   }

@@ -12,7 +12,7 @@
 using namespace occull;
 
 TEST(StallGuard, AResultNotThereInTimeCountsAsVisibleAndIsReadOnceItArrives) {
-  test::RecordingBackend backend;
+  test::ScriptedBackend backend;
   backend.visible_samples = [](std::span<const Aabb>) { return std::uint64_t(0); };  // all hidden
   bool arrived = false;
   backend.available = [&](QueryId q) { return q != 1 || arrived; };
@@ -35,7 +35,7 @@ TEST(StallGuard, AResultNotThereInTimeCountsAsVisibleAndIsReadOnceItArrives) {
 }
 
 TEST(StallGuard, QueriesStillOutstandingAreReadWhenTheGuardGoes) {
-  test::RecordingBackend backend;
+  test::ScriptedBackend backend;
   backend.available = [](QueryId) { return false; };
   const Aabb box{{0, 0, 0}, {1, 1, 1}};
   {
@@ -59,7 +59,7 @@ TEST(StallGuard, AConservativeCullerBehindItDrawsWhatANeverAnsweringDriverHid) {
   const View view = make_view({{0, 0, 0}, 0, 0}, {60.0f, 0.1f, 200.0f}, 64, 64);
   for (const char* algo : {"stopwait", "chc", "chcpp"}) {
     auto culler = make_culler(algo, {scene, bvh});
-    test::RecordingBackend backend;
+    test::ScriptedBackend backend;
     backend.visible_samples = [](std::span<const Aabb>) { return std::uint64_t(0); };
     backend.available = [](QueryId) { return false; };
     StallGuard guard(backend, 0.0);

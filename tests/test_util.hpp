@@ -111,10 +111,10 @@ inline Scene glass_scene() {
 /// or polled after it was read, or that this backend never issued (one of
 /// another device: give two backends different `first_id`s to tell them
 /// apart). in_flight() counts the queries issued and never read.
-class RecordingBackend final : public Backend {
+class ScriptedBackend final : public Backend {
  public:
   /// Query ids start at `first_id`: query q is queried[q - first_id].
-  explicit RecordingBackend(QueryId first_id = 0) : first_id_(first_id) {}
+  explicit ScriptedBackend(QueryId first_id = 0) : first_id_(first_id) {}
 
   std::function<std::uint64_t(std::span<const Aabb>)> visible_samples =
       [](std::span<const Aabb> b) { return std::uint64_t(b.size()); };
@@ -139,7 +139,7 @@ class RecordingBackend final : public Backend {
     render(objects);
   }
   QueryId issue_query(std::span<const Aabb> boxes) override {
-    if (boxes.empty()) throw std::logic_error("RecordingBackend::issue_query: no boxes");
+    if (boxes.empty()) throw std::logic_error("ScriptedBackend::issue_query: no boxes");
     queried.emplace_back(boxes.begin(), boxes.end());
     results_.push_back(visible_samples(boxes));
     live_.push_back(1);
@@ -166,10 +166,10 @@ class RecordingBackend final : public Backend {
  private:
   void check_in_flight(QueryId q, const char* call) const {
     if (q < first_id_ || q - first_id_ >= live_.size())
-      throw std::logic_error("RecordingBackend::" + std::string(call) + ": query " + std::to_string(q) +
+      throw std::logic_error("ScriptedBackend::" + std::string(call) + ": query " + std::to_string(q) +
                              " was never issued by this backend");
     if (!live_[q - first_id_])
-      throw std::logic_error("RecordingBackend::" + std::string(call) + ": query " + std::to_string(q) +
+      throw std::logic_error("ScriptedBackend::" + std::string(call) + ": query " + std::to_string(q) +
                              " was read already");
   }
 

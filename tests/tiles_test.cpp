@@ -213,7 +213,7 @@ struct TiledCase {
 TEST(TilesCuller, PropagationStopsWhereTheCommonBoxIsOccluded) {
   TiledCase t;
   const View v = t.look({1.0f, 1.7f, -20.0f}, 0.3f);
-  test::RecordingBackend backend;
+  test::ScriptedBackend backend;
   backend.visible_samples = [](std::span<const Aabb>) { return std::uint64_t(0); };
   Options o;
   o.set("tiles.local=none");
@@ -233,7 +233,7 @@ TEST(TilesCuller, PropagationStopsWhereTheCommonBoxIsOccluded) {
 TEST(TilesCuller, AllQueriesVisibleDrawsEveryCellInTheFrustumOnce) {
   TiledCase t;
   const View v = t.look({1.0f, 1.7f, -20.0f}, 0.3f, -0.05f);
-  test::RecordingBackend backend;
+  test::ScriptedBackend backend;
   Options o;
   o.set("tiles.local=none");
   auto culler = make_culler("tiles", t.index(), o);
@@ -250,7 +250,7 @@ TEST(TilesCuller, AllQueriesVisibleDrawsEveryCellInTheFrustumOnce) {
 TEST(TilesCuller, PendingResultOfATileVisibleLastFrameIsPostponed) {
   TiledCase t;
   const View v = t.look({1.0f, 1.7f, -20.0f}, 0.3f);
-  test::RecordingBackend backend;
+  test::ScriptedBackend backend;
   bool ready = true;
   backend.available = [&](QueryId) { return ready; };
   Options o;
@@ -278,7 +278,7 @@ TEST(TilesCuller, PendingResultOfATileVisibleLastFrameIsPostponed) {
 
 TEST(TileCache, InstancesUnusedForTheEvictionTimeAreFreed) {
   TiledCase t;
-  test::RecordingBackend backend;
+  test::ScriptedBackend backend;
   Options o;
   o.set("pertile.evict=3");
   auto culler = make_culler("pertile", t.index(), o);
@@ -306,7 +306,7 @@ TEST(TilesCuller, RequeryDrawsVisibleTilesWithoutQueriesBetweenTheirReQueries) {
   const View v = t.look({1.0f, 1.7f, -20.0f}, 0.3f, -0.05f);
   std::uint64_t queries[2] = {0, 0}, drawn[2] = {0, 0};
   for (int variant = 0; variant < 2; ++variant) {
-    test::RecordingBackend backend;
+    test::ScriptedBackend backend;
     Options o;
     o.set("tiles.local=none");
     if (variant == 1) o.set("tiles.requery=4");

@@ -590,7 +590,7 @@ int cmd_render(const RenderArgs& a) {
     std::vector<std::uint8_t> pixels = session.renderer().read_rgba();
     std::string legend;
     if (painter) {
-      const auto frame_objects = session.renderer().frame_objects();
+      const auto frame_objects = session.recording().objects();
       const std::vector<occull::ObjectId> drawn(frame_objects.begin(), frame_objects.end());
       std::vector<occull::ObjectId> truth;
       if (view == occull::DebugView::overview)  // the verifier's view: what was missed

@@ -331,7 +331,7 @@ int run_viewer(const ViewArgs& a) {
     FrameLog log;
     const FrameStats stats = session.run_frame(*culler, view, time_s, &log);
     image = session.renderer().read_rgba();
-    const auto drawn_span = session.renderer().frame_objects();
+    const auto drawn_span = session.recording().objects();
     const std::vector<ObjectId> drawn(drawn_span.begin(), drawn_span.end());
     std::vector<ObjectId> truth, missed;
     if (c.verify) {

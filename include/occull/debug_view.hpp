@@ -114,7 +114,7 @@ struct DebugFrame {
   const View& view;          ///< the frame's view
   const FrameLog& log;       ///< its backend calls (LoggingBackend)
   std::span<const CullRegion> regions;  ///< the culler's (Culler::regions)
-  std::span<const ObjectId> drawn;      ///< objects the frame drew (gl::Renderer::frame_objects)
+  std::span<const ObjectId> drawn;      ///< objects the frame drew (RecordingBackend::objects, Session::recording)
   /// Objects with a visible pixel (ground truth), sorted; the overview
   /// marks those not drawn as missed. Empty: not known.
   std::span<const ObjectId> truth;

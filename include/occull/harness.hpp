@@ -21,6 +21,7 @@
 #include "occull/cost_model.hpp"
 #include "occull/culler.hpp"
 #include "occull/frame_log.hpp"
+#include "occull/recording_backend.hpp"
 #include "occull/gl/context.hpp"
 #include "occull/gl/renderer.hpp"
 #include "occull/scenes.hpp"
@@ -259,8 +260,12 @@ class Session {
   /// milliseconds (0, the default: none, results are waited for).
   /// Throws InputError for a negative or non-finite time.
   void set_stall_guard(double timeout_ms);
-  /// What culler frames render through: the renderer, or its StallGuard.
+  /// What culler frames render through: the renderer under the session's
+  /// RecordingBackend, and over both the StallGuard when one is set.
   [[nodiscard]] Backend& backend() noexcept;
+  /// What the last culler frame drew and queried (run_frame() starts and
+  /// finishes the record with the frame).
+  [[nodiscard]] const RecordingBackend& recording() const noexcept { return *recorder_; }
 
   /// Where frames lie on paths (default: spread over the whole path).
   void set_sampling(const FrameSampling& sampling) { sampling_ = sampling; }
@@ -318,7 +323,13 @@ class Session {
   gl::ContextOptions context_options_;
   std::unique_ptr<gl::Renderer> renderer_;
   double stall_guard_ms_ = 0.0;
-  std::unique_ptr<StallGuard> guard_;  // over renderer_; goes before it
+  // The backend chain of culler frames: renderer_ <- recorder_ (what the
+  // frame drew and queried, for verification and the cost model) <- guard_
+  // (with a stall guard) <- logger_ (logged frames). Each goes before what
+  // it wraps.
+  std::unique_ptr<RecordingBackend> recorder_;
+  std::unique_ptr<StallGuard> guard_;
+  void wrap_renderer();  // (re)builds recorder_ and guard_ over renderer_
   std::unique_ptr<LoggingBackend> logger_;  // over backend(), for logged frames; goes before both
   std::unique_ptr<detail::Watchdog> watchdog_;
   std::optional<HardwareProfile> profile_;

@@ -57,7 +57,15 @@ Session::Session(std::string_view scene_spec, const gl::RendererOptions& rendere
   device_ = context_->info();
   renderer_options_ = renderer_options;
   renderer_ = std::make_unique<gl::Renderer>(bundle_.scene, renderer_options);
+  wrap_renderer();
   set_watchdog(kWatchdogSeconds);
+}
+
+void Session::wrap_renderer() {
+  logger_.reset();  // it wraps what backend() was
+  guard_.reset();   // reads the queries it gave up on, through the recorder
+  recorder_ = std::make_unique<RecordingBackend>(*renderer_, bundle_.scene);
+  guard_ = stall_guard_ms_ > 0.0 ? std::make_unique<StallGuard>(*recorder_, stall_guard_ms_) : nullptr;
 }
 
 void Session::set_watchdog(double seconds) {
@@ -70,29 +78,30 @@ void Session::set_stall_guard(double timeout_ms) {
   if (!(timeout_ms >= 0.0) || !std::isfinite(timeout_ms))
     throw InputError(fmt::format("stall guard {} ms: must be a number of milliseconds >= 0 (0: off)", timeout_ms));
   stall_guard_ms_ = timeout_ms;
-  logger_.reset();  // it wraps what backend() was
-  guard_ = timeout_ms > 0.0 ? std::make_unique<StallGuard>(*renderer_, timeout_ms) : nullptr;
+  wrap_renderer();
 }
 
 Backend& Session::backend() noexcept {
   if (guard_) return *guard_;
-  return *renderer_;
+  return *recorder_;
 }
 
 void Session::reset_renderer() {
   logger_.reset();
   guard_.reset();
+  recorder_.reset();
   renderer_.reset();
   retired_.reset();  // idle since the previous replacement
   retired_ = std::move(context_);
   context_ = gl::Context::create(context_options_);
   renderer_ = std::make_unique<gl::Renderer>(bundle_.scene, renderer_options_);
-  set_stall_guard(stall_guard_ms_);
+  wrap_renderer();
 }
 
 Session::~Session() {
   logger_.reset();
   guard_.reset();     // reads the queries it gave up on
+  recorder_.reset();
   renderer_.reset();  // GL objects go before the context
   context_.reset();
   retired_.reset();
@@ -123,6 +132,7 @@ FrameStats Session::run_frame(Culler& culler, const View& view, double time_s, F
   const auto t0 = Clock::now();
   if (!bundle_.world) bvh_.refit(bundle_.scene);
   renderer_->begin_frame(view);
+  recorder_->start_frame();
   if (log && !logger_) logger_ = std::make_unique<LoggingBackend>(this->backend());
   if (logger_) logger_->log_into(log);
   Backend& backend = log ? static_cast<Backend&>(*logger_) : this->backend();
@@ -135,6 +145,7 @@ FrameStats Session::run_frame(Culler& culler, const View& view, double time_s, F
   context_->check("a culler's frame");  // before end_frame's own glGetError, which knows less
   s.gpu_ms = renderer_->end_frame();
   const auto t1 = Clock::now();
+  recorder_->finish_frame([this](QueryId q) { return renderer_->unread_result(q); });
   const ProcessUsage u1 = process_usage();
   const BackendStats d = backend.stats() - before;
   s.minor_faults = u1.minor_faults - u0.minor_faults;
@@ -235,7 +246,7 @@ double Session::predicted_frame_ms(const View& view) {
   const Scene& scene = bundle_.scene;
   const double pixels = double(view.width) * double(view.height);
   double ms = 0.0;
-  for (ObjectId id : renderer_->frame_objects()) {
+  for (ObjectId id : recorder_->objects()) {
     const Object& o = scene.object(id);
     NodeCost c;
     c.draws = 1;
@@ -245,9 +256,9 @@ double Session::predicted_frame_ms(const View& view) {
     c.r_cov = coverage_ratio(scene.object_surface_area(id), o.bounds.surface_area());
     ms += render_time(hw, c, view.width, view.height);
   }
-  const auto boxes = renderer_->frame_query_boxes();
+  const auto boxes = recorder_->query_boxes();
   std::size_t next = 0;
-  for (std::uint32_t n : renderer_->frame_query_sizes()) {
+  for (std::uint32_t n : recorder_->query_sizes()) {
     double covered = 0.0;
     for (std::uint32_t i = 0; i < n; ++i)
       covered += projected_area(boxes[next + i], view.view_proj, view.width, view.height) / pixels;

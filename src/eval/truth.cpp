@@ -104,9 +104,9 @@ std::vector<ObjectId> Session::verify_frame(std::string_view name, const Culler&
   const Coverage frame = detail::depth_coverage(depth);
   detail::check_frame_within_truth(where, std::string(name), t.coverage, frame);
   if (dynamic_cast<const detail::OracleCuller*>(&culler))
-    detail::check_oracle_draws_truth(where, t.visible, renderer_->frame_objects(), t.coverage.depth_hash,
+    detail::check_oracle_draws_truth(where, t.visible, recorder_->objects(), t.coverage.depth_hash,
                                      frame.depth_hash);
-  return check_frame(t.visible, renderer_->frame_objects(), bundle_.scene.objects().size(), s);
+  return check_frame(t.visible, recorder_->objects(), bundle_.scene.objects().size(), s);
 }
 
 void MissRuns::add(const std::vector<ObjectId>& missed) {

@@ -1,5 +1,6 @@
 #include "occull/gl/renderer.hpp"
 
+#include "renderer_impl.hpp"
 #include "gl.hpp"
 #include "occull/input_limits.hpp"
 #include "scene_mesh.hpp"
@@ -17,6 +18,10 @@
 
 namespace occull::gl {
 namespace {
+
+using detail::DrawCommand;
+using detail::kNoQuery;
+using detail::MaterialData;
 
 using Clock = std::chrono::steady_clock;
 
@@ -179,10 +184,6 @@ const char* kQueryFragment = R"(#version 450 core
 void main() {}
 )";
 
-struct MaterialData {
-  glm::vec4 color;  // alpha 1 for opaque materials
-  GLint lights = 0;  // shading cost: extra lights evaluated per fragment
-};
 
 GLenum query_target(QueryMode mode) {
   switch (mode) {
@@ -193,19 +194,12 @@ GLenum query_target(QueryMode mode) {
   return GL_SAMPLES_PASSED;
 }
 
-// Layout of glMultiDrawElementsIndirect's commands.
-struct DrawCommand {
-  GLuint count, instance_count, first_index;
-  GLint base_vertex;
-  GLuint base_instance;
-};
 
 constexpr GLsizeiptr kBoxCapacity = 1 << 16;
 
 // Under --draw multi, material runs shorter than this are drawn one object
 // at a time (see draw_objects).
 constexpr std::size_t kMinMultiDrawRun = 16;
-constexpr QueryId kNoQuery = ~QueryId(0);  // boxes per stream-buffer fill
 
 // The query mesh: the 36 vertices of a unit cube's faces (outward,
 // counter-clockwise; corner i has bit 0 = x, bit 1 = y, bit 2 = z, as
@@ -241,126 +235,18 @@ bool has_extension(const char* name) {
 
 }  // namespace
 
-struct Renderer::Impl {
-  const Scene& scene;
-  RendererOptions options;
-  GLenum target = GL_SAMPLES_PASSED;
 
-  GLuint vertex_buffer = 0, index_buffer = 0, object_index_buffer = 0;
-  GLuint object_buffer = 0;  // model matrices, read by the multi-draw program only
-  std::vector<MaterialData> materials;
-  GLuint scene_vao = 0, scene_program = 0;
-  GLint u_scene_view_proj = -1, u_color = -1, u_lights = -1, u_model = -1, u_object = -1, u_eye = -1,
-        u_background = -1, u_fog = -1;
-  GLuint cube_vertices = 0, box_buffer = 0;
-  GLuint query_vao = 0, query_program = 0;
-  GLint u_query_view_proj = -1, u_query_eye = -1, u_query_half_viewport = -1, u_query_margin = -1;
-  QueryRaster query_raster = QueryRaster::margin;  // what is in effect (hardware falls back to margin)
-  GLenum conservative_cap = 0;                     // GL_CONSERVATIVE_RASTERIZATION_{NV,INTEL} when present
-  GLsizei query_vertices = 36;                     // faces only, or faces and silhouette bands
-  float query_slope_px = 0.0f;                     // polygon-offset slope factor of query boxes
-  // The clip conventions of the pass's view: depth range, and with reversed-Z
-  // the depth tests, the depth clear and the polygon offset turn around.
-  ClipSpace clip;
-  [[nodiscard]] GLenum depth_less() const { return clip.reversed_z ? GL_GREATER : GL_LESS; }
-  [[nodiscard]] GLenum depth_less_equal() const { return clip.reversed_z ? GL_GEQUAL : GL_LEQUAL; }
-  [[nodiscard]] float depth_far() const { return clip.reversed_z ? 0.0f : 1.0f; }
-  GLuint fbo = 0, color_rb = 0, depth_rb = 0, id_rb = 0;
-  GLuint timer = 0;
-  bool timer_supported = false;
-  bool write_ids = true;
+void Renderer::Impl::split_translucent(std::span<const ObjectId> objects, std::vector<ObjectId>& translucent_out) {
+  opaque.clear();
+  for (ObjectId id : objects)
+    (scene.material(scene.object(id).material).translucent ? translucent_out : opaque).push_back(id);
+}
 
-  std::vector<MeshRange> meshes;
-  std::vector<GLuint> query_names;  // QueryId -> GL name (all of `target`)
-  // Which queries the device has been handed (a flush since their issue):
-  // polling or reading one that was not makes the driver flush.
-  std::vector<std::uint64_t> query_serial;  // QueryId -> issue_serial when issued
-  std::vector<std::uint8_t> query_live;     // QueryId -> issued and not yet read
-  // Backend's precondition "q in flight", checked on every use of a query:
-  // a query read twice would be freed twice and later handed to two users.
-  void check_in_flight(QueryId q, const char* call) const {
-    if (q >= query_live.size() || !query_live[q])
-      throw std::logic_error(fmt::format("gl::Renderer::{}: query {} is not in flight ({})", call, q,
-                                         q >= query_live.size() ? "never issued by this renderer"
-                                                                : "already read, or issued by another renderer"));
-  }
-  std::uint64_t issue_serial = 0;           // queries issued so far
-  std::uint64_t flushed_serial = 0;         // issue_serial at the last flush
-  void note_flush_for(QueryId q, BackendStats& stats) {
-    if (q != kNoQuery && query_serial[q] <= flushed_serial) return;
-    ++stats.flushes;
-    flushed_serial = issue_serial;
-  }
-  std::vector<QueryId> free_queries;
-  std::uint64_t uploaded_revision = 0;  // Scene::placement_revision() of the transforms on the device
-  std::size_t object_capacity = 0;      // objects the per-object buffers hold
-  std::size_t in_flight = 0;
-  // Every buffer object the renderer owns.
-  [[nodiscard]] std::array<GLuint, 7> buffer_names() const {
-    return {vertex_buffer, index_buffer, object_index_buffer, object_buffer, cube_vertices, box_buffer,
-            indirect_buffer};
-  }
-  GLsizeiptr box_offset = 0;  // next free box in the stream buffer
-
-  enum class Mode { none, render, query } mode = Mode::none;
-  MaterialId bound_material = ~0u;
-  glm::vec3 eye{0.0f};
-  float near_radius = 0.0f;
-  bool query_culls_back = true;
-  std::vector<ObjectId> opaque;
-  std::vector<ObjectId> translucent;  // deferred to end_frame
-  std::vector<ObjectId> frame_objects;  // everything drawn this frame (see frame_objects())
-  // Conditional draws of this frame whose query result is not known yet:
-  // their objects join frame_objects once it is, if samples passed.
-  struct ConditionalDraw {
-    QueryId query;
-    std::uint64_t serial;  // query_serial of the query when drawn
-    std::size_t begin, count;  // in conditional_objects
-  };
-  std::vector<ConditionalDraw> conditional;
-  std::vector<ObjectId> conditional_objects;
-  void settle(const ConditionalDraw& d, std::uint64_t samples, BackendStats& stats) {
-    if (samples == 0) stats.conditional_skipped += d.count;
-    if (samples > 0)
-      frame_objects.insert(frame_objects.end(), conditional_objects.begin() + long(d.begin),
-                           conditional_objects.begin() + long(d.begin + d.count));
-  }
-  // Query q's result is `samples`: settles the draws conditional on it.
-  void settle_conditional(QueryId q, std::uint64_t samples, BackendStats& stats) {
-    std::erase_if(conditional, [&](const ConditionalDraw& d) {
-      if (d.query != q || d.serial != query_serial[q]) return false;
-      settle(d, samples, stats);
-      return true;
-    });
-  }
-  void start_frame_record() {
-    frame_objects.clear();
-    conditional.clear();
-    conditional_objects.clear();
-  }
-  std::vector<Aabb> frame_query_boxes;     // every query box this frame
-  std::vector<std::uint32_t> frame_query_sizes;
-  GLuint truth_query = 0;             // GL_SAMPLES_PASSED, for visible_pixels only
-  std::vector<std::uint32_t> pixel_counts;  // per object, scratch of visible_pixels
-  GLuint indirect_buffer = 0;         // multi-draw commands, refilled every frame
-  GLsizeiptr indirect_capacity = 0, indirect_offset = 0;
-  std::vector<DrawCommand> commands;
-
-  Impl(const Scene& s, const RendererOptions& o) : scene(s), options(o) {}
-
-  void create_targets();
-  void create_scene_buffers();
-  void create_query_resources();
-  void apply_draw_buffers() const;
-  void establish_frame_state() const;
-  void prepare_pass(const View& view);
-  std::uint64_t samples_passing(std::span<const ObjectId> ids);
-  void enter_render_state(BackendStats& stats);
-  void enter_query_state(BackendStats& stats);
-  void draw_objects(std::span<const ObjectId> ids, BackendStats& stats);
-  void multi_draw(std::span<const ObjectId> ids);
-  void upload_dynamic_transforms();
-};
+void Renderer::Impl::sort_opaque_by_material() {
+  std::stable_sort(opaque.begin(), opaque.end(), [&](ObjectId a, ObjectId b) {
+    return scene.object(a).material < scene.object(b).material;
+  });
+}
 
 void Renderer::Impl::create_targets() {
   glCreateRenderbuffers(1, &color_rb);
@@ -707,9 +593,7 @@ void Renderer::Impl::prepare_pass(const View& view) {
   eye = view.eye;
   near_radius = near_plane_radius(view);
   translucent.clear();
-  start_frame_record();
-  frame_query_boxes.clear();
-  frame_query_sizes.clear();
+  conditional.clear();
   bound_material = ~0u;
   // Start in render state without counting it as a change.
   mode = Mode::none;
@@ -765,7 +649,7 @@ double Renderer::end_frame() {
     assert(d.serial == g.query_serial[d.query]);  // not read, so not reissued
     GLuint64 samples = 0;
     glGetQueryObjectui64v(g.query_names[d.query], GL_QUERY_RESULT, &samples);
-    g.settle(d, samples, stats_);
+    if (samples == 0) stats_.conditional_skipped += d.count;
   }
   g.conditional.clear();
   double gpu_ms = 0.0;
@@ -782,17 +666,8 @@ void Renderer::render(std::span<const ObjectId> objects) {
   Impl& g = *impl_;
   ScopedTimer timer(stats_.backend_ms);
   ++stats_.render_flushes;
-  g.frame_objects.insert(g.frame_objects.end(), objects.begin(), objects.end());
-  g.opaque.clear();
-  for (ObjectId id : objects) {
-    if (g.scene.material(g.scene.object(id).material).translucent)
-      g.translucent.push_back(id);
-    else
-      g.opaque.push_back(id);
-  }
-  std::stable_sort(g.opaque.begin(), g.opaque.end(), [&](ObjectId a, ObjectId b) {
-    return g.scene.object(a).material < g.scene.object(b).material;
-  });
+  g.split_translucent(objects, g.translucent);
+  g.sort_opaque_by_material();
   if (!g.opaque.empty()) g.draw_objects(g.opaque, stats_);
 }
 
@@ -801,21 +676,10 @@ void Renderer::render_conditional(std::span<const ObjectId> objects, QueryId q, 
   g.check_in_flight(q, "render_conditional");
   ScopedTimer timer(stats_.backend_ms);
   ++stats_.render_flushes;
-  g.opaque.clear();
-  for (ObjectId id : objects) {
-    if (g.scene.material(g.scene.object(id).material).translucent) {
-      g.translucent.push_back(id);
-      g.frame_objects.push_back(id);
-    } else {
-      g.opaque.push_back(id);
-    }
-  }
+  g.split_translucent(objects, g.translucent);  // translucent ones: deferred, drawn in any case
   if (g.opaque.empty()) return;
-  std::stable_sort(g.opaque.begin(), g.opaque.end(), [&](ObjectId a, ObjectId b) {
-    return g.scene.object(a).material < g.scene.object(b).material;
-  });
-  g.conditional.push_back({q, g.query_serial[q], g.conditional_objects.size(), g.opaque.size()});
-  g.conditional_objects.insert(g.conditional_objects.end(), g.opaque.begin(), g.opaque.end());
+  g.sort_opaque_by_material();
+  g.conditional.push_back({q, g.query_serial[q], g.opaque.size()});
   stats_.conditional_objects += g.opaque.size();
   g.enter_render_state(stats_);
   glBeginConditionalRender(g.query_names[q], wait == ConditionalWait::wait ? GL_QUERY_WAIT : GL_QUERY_NO_WAIT);
@@ -867,8 +731,6 @@ QueryId Renderer::issue_query(std::span<const Aabb> boxes) {
     done += n;
   }
   glEndQuery(g.target);
-  g.frame_query_boxes.insert(g.frame_query_boxes.end(), boxes.begin(), boxes.end());
-  g.frame_query_sizes.push_back(std::uint32_t(boxes.size()));
   ++stats_.queries;
   stats_.query_boxes += boxes.size();
   return q;
@@ -917,104 +779,20 @@ void Renderer::set_write_ids(bool on) {
   impl_->apply_draw_buffers();
 }
 
-std::vector<std::uint32_t> Renderer::read_ids() const {
-  const Impl& g = *impl_;
-  std::vector<std::uint32_t> ids(std::size_t(g.options.width) * std::size_t(g.options.height));
-  glNamedFramebufferReadBuffer(g.fbo, GL_COLOR_ATTACHMENT1);
-  bind_for_reading(g.fbo, 4);
-  glReadPixels(0, 0, g.options.width, g.options.height, GL_RED_INTEGER, GL_UNSIGNED_INT, ids.data());
-  check_error("reading the id buffer");
-  return ids;
-}
 
-std::vector<std::uint8_t> Renderer::read_rgba() const {
-  const Impl& g = *impl_;
-  return read_rgba_top_first(g.fbo, g.options.width, g.options.height);
-}
 
-std::span<const ObjectId> Renderer::frame_objects() const noexcept { return impl_->frame_objects; }
-std::span<const Aabb> Renderer::frame_query_boxes() const noexcept { return impl_->frame_query_boxes; }
-std::span<const std::uint32_t> Renderer::frame_query_sizes() const noexcept {
-  return impl_->frame_query_sizes;
-}
-
-// Draws `ids` against the depth buffer as it stands, writing nothing, and
-// returns the samples that pass (the scene pass's depth test). Not counted.
-std::uint64_t Renderer::Impl::samples_passing(std::span<const ObjectId> ids) {
-  BackendStats ignored;
-  enter_render_state(ignored);
-  glDepthMask(GL_FALSE);
-  glColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
-  glBeginQuery(GL_SAMPLES_PASSED, truth_query);
-  draw_objects(ids, ignored);
-  glEndQuery(GL_SAMPLES_PASSED);
-  glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
-  glDepthMask(GL_TRUE);
-  GLuint64 n = 0;
+std::uint64_t Renderer::unread_result(QueryId q) {
+  Impl& g = *impl_;
+  g.check_in_flight(q, "unread_result");
+  GLuint64 samples = 0;
   glBindBuffer(GL_QUERY_BUFFER, 0);
-  glGetQueryObjectui64v(truth_query, GL_QUERY_RESULT, &n);
-  return n;
+  glGetQueryObjectui64v(g.query_names[q], GL_QUERY_RESULT, &samples);
+  return samples;
 }
 
-std::uint64_t Renderer::samples_in_front(const View& view, std::span<const ObjectId> objects) {
-  Impl& g = *impl_;
-  g.prepare_pass(view);
-  const std::uint64_t n = objects.empty() ? 0 : g.samples_passing(objects);
-  glFinish();
-  g.start_frame_record();
-  check_error("counting samples in front of the depth buffer");
-  return n;
-}
 
-std::vector<float> Renderer::read_depth() const {
-  const Impl& g = *impl_;
-  std::vector<float> depth(std::size_t(g.options.width) * std::size_t(g.options.height));
-  bind_for_reading(g.fbo, 4);
-  glReadPixels(0, 0, g.options.width, g.options.height, GL_DEPTH_COMPONENT, GL_FLOAT, depth.data());
-  check_error("reading the depth buffer");
-  if (g.clip.reversed_z)  // canonical: 0 nearest, 1 farthest and nothing
-    for (float& d : depth) d = 1.0f - d;
-  return depth;
-}
 
-std::vector<Renderer::ObjectPixels> Renderer::visible_pixels(const View& view,
-                                                             std::span<const ObjectId> objects,
-                                                             PassImages* images) {
-  Impl& g = *impl_;
-  const BackendStats saved_stats = stats_;
-  const bool saved_ids = g.write_ids;
-  set_write_ids(true);
-  begin_frame(view);
-  g.opaque.clear();
-  std::vector<ObjectId> translucent;
-  for (ObjectId id : objects)
-    (g.scene.material(g.scene.object(id).material).translucent ? translucent : g.opaque).push_back(id);
-  g.draw_objects(g.opaque, stats_);
 
-  std::vector<std::uint64_t> samples(translucent.size());
-  for (std::size_t i = 0; i < translucent.size(); ++i)
-    samples[i] = g.samples_passing(std::span<const ObjectId>(&translucent[i], 1));
-  end_frame();
-
-  std::vector<std::uint32_t> ids = read_ids();
-  g.pixel_counts.assign(g.scene.objects().size(), 0);
-  for (std::uint32_t v : ids)
-    if (v != 0) ++g.pixel_counts[v - 1];
-  if (images) {
-    images->ids = std::move(ids);
-    images->depth = read_depth();
-  }
-  for (std::size_t i = 0; i < translucent.size(); ++i)
-    g.pixel_counts[translucent[i]] = std::uint32_t(std::min<std::uint64_t>(samples[i], 0xffffffffu));
-  std::vector<ObjectPixels> visible;
-  for (ObjectId id = 0; id < g.pixel_counts.size(); ++id)
-    if (g.pixel_counts[id] > 0) visible.push_back({id, g.pixel_counts[id]});
-
-  set_write_ids(saved_ids);
-  g.start_frame_record();
-  stats_ = saved_stats;
-  return visible;
-}
 
 std::size_t Renderer::queries_in_flight() const noexcept { return impl_->in_flight; }
 

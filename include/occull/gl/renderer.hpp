@@ -136,18 +136,12 @@ class Renderer final : public Backend {
   void render_conditional(std::span<const ObjectId> objects, QueryId q, ConditionalWait wait) override;
   [[nodiscard]] BackendStats stats() const override { return stats_; }
 
-  /// Objects drawn since begin_frame(): those passed to render() in call
-  /// order (translucent ones included), and those of render_conditional()
-  /// whose query had samples pass, once that result is known (when the
-  /// culler reads it, at the latest in end_frame()). Under
-  /// ConditionalWait::no_wait the device may also have drawn the others;
-  /// their query found them hidden.
-  [[nodiscard]] std::span<const ObjectId> frame_objects() const noexcept;
-
-  /// Boxes of the queries issued since begin_frame(), in order, and how many
-  /// boxes each query had (for the cost model's prediction of a frame).
-  [[nodiscard]] std::span<const Aabb> frame_query_boxes() const noexcept;
-  [[nodiscard]] std::span<const std::uint32_t> frame_query_sizes() const noexcept;
+  /// The result of query `q` without ending its flight: the culler that
+  /// issued it still reads it with result(). Waits for the device if the
+  /// result is not there; not counted in stats(). For an instrument after
+  /// end_frame() (RecordingBackend::finish_frame: what a conditional draw
+  /// drew). Precondition: `q` is in flight (std::logic_error otherwise).
+  [[nodiscard]] std::uint64_t unread_result(QueryId q);
 
   /// One object's visible area in a visible_pixels() pass.
   struct ObjectPixels {

@@ -1,0 +1,149 @@
+// The reference renderer's state, shared by its files: renderer.cpp (the
+// scene resources and the Backend's frame passes) and renderer_truth.cpp
+// (the untimed truth pass and the read-backs over the same resources).
+// Internal to occull_gl.
+#pragma once
+
+#include "occull/gl/renderer.hpp"
+
+#include "gl.hpp"
+#include "scene_mesh.hpp"
+
+#include <fmt/format.h>
+
+#include <array>
+#include <stdexcept>
+#include <vector>
+
+namespace occull::gl {
+namespace detail {
+
+struct MaterialData {
+  glm::vec4 color;  // alpha 1 for opaque materials
+  GLint lights = 0;  // shading cost: extra lights evaluated per fragment
+};
+
+// Layout of glMultiDrawElementsIndirect's commands.
+struct DrawCommand {
+  GLuint count, instance_count, first_index;
+  GLint base_vertex;
+  GLuint base_instance;
+};
+
+constexpr QueryId kNoQuery = ~QueryId(0);  // boxes per stream-buffer fill
+
+}  // namespace detail
+
+struct Renderer::Impl {
+  const Scene& scene;
+  RendererOptions options;
+  GLenum target = GL_SAMPLES_PASSED;
+
+  GLuint vertex_buffer = 0, index_buffer = 0, object_index_buffer = 0;
+  GLuint object_buffer = 0;  // model matrices, read by the multi-draw program only
+  std::vector<detail::MaterialData> materials;
+  GLuint scene_vao = 0, scene_program = 0;
+  GLint u_scene_view_proj = -1, u_color = -1, u_lights = -1, u_model = -1, u_object = -1, u_eye = -1,
+        u_background = -1, u_fog = -1;
+  GLuint cube_vertices = 0, box_buffer = 0;
+  GLuint query_vao = 0, query_program = 0;
+  GLint u_query_view_proj = -1, u_query_eye = -1, u_query_half_viewport = -1, u_query_margin = -1;
+  QueryRaster query_raster = QueryRaster::margin;  // what is in effect (hardware falls back to margin)
+  GLenum conservative_cap = 0;                     // GL_CONSERVATIVE_RASTERIZATION_{NV,INTEL} when present
+  GLsizei query_vertices = 36;                     // faces only, or faces and silhouette bands
+  float query_slope_px = 0.0f;                     // polygon-offset slope factor of query boxes
+  // The clip conventions of the pass's view: depth range, and with reversed-Z
+  // the depth tests, the depth clear and the polygon offset turn around.
+  ClipSpace clip;
+  [[nodiscard]] GLenum depth_less() const { return clip.reversed_z ? GL_GREATER : GL_LESS; }
+  [[nodiscard]] GLenum depth_less_equal() const { return clip.reversed_z ? GL_GEQUAL : GL_LEQUAL; }
+  [[nodiscard]] float depth_far() const { return clip.reversed_z ? 0.0f : 1.0f; }
+  GLuint fbo = 0, color_rb = 0, depth_rb = 0, id_rb = 0;
+  GLuint timer = 0;
+  bool timer_supported = false;
+  bool write_ids = true;
+
+  std::vector<MeshRange> meshes;
+  std::vector<GLuint> query_names;  // QueryId -> GL name (all of `target`)
+  // Which queries the device has been handed (a flush since their issue):
+  // polling or reading one that was not makes the driver flush.
+  std::vector<std::uint64_t> query_serial;  // QueryId -> issue_serial when issued
+  std::vector<std::uint8_t> query_live;     // QueryId -> issued and not yet read
+  // Backend's precondition "q in flight", checked on every use of a query:
+  // a query read twice would be freed twice and later handed to two users.
+  void check_in_flight(QueryId q, const char* call) const {
+    if (q >= query_live.size() || !query_live[q])
+      throw std::logic_error(fmt::format("gl::Renderer::{}: query {} is not in flight ({})", call, q,
+                                         q >= query_live.size() ? "never issued by this renderer"
+                                                                : "already read, or issued by another renderer"));
+  }
+  std::uint64_t issue_serial = 0;           // queries issued so far
+  std::uint64_t flushed_serial = 0;         // issue_serial at the last flush
+  void note_flush_for(QueryId q, BackendStats& stats) {
+    if (q != detail::kNoQuery && query_serial[q] <= flushed_serial) return;
+    ++stats.flushes;
+    flushed_serial = issue_serial;
+  }
+  std::vector<QueryId> free_queries;
+  std::uint64_t uploaded_revision = 0;  // Scene::placement_revision() of the transforms on the device
+  std::size_t object_capacity = 0;      // objects the per-object buffers hold
+  std::size_t in_flight = 0;
+  // Every buffer object the renderer owns.
+  [[nodiscard]] std::array<GLuint, 7> buffer_names() const {
+    return {vertex_buffer, index_buffer, object_index_buffer, object_buffer, cube_vertices, box_buffer,
+            indirect_buffer};
+  }
+  GLsizeiptr box_offset = 0;  // next free box in the stream buffer
+
+  enum class Mode { none, render, query } mode = Mode::none;
+  MaterialId bound_material = ~0u;
+  glm::vec3 eye{0.0f};
+  float near_radius = 0.0f;
+  bool query_culls_back = true;
+  std::vector<ObjectId> opaque;
+  std::vector<ObjectId> translucent;  // deferred to end_frame
+  // Conditional draws of this frame whose query result is not known yet:
+  // once it is, those whose query passed no samples count as skipped.
+  struct ConditionalDraw {
+    QueryId query;
+    std::uint64_t serial;  // query_serial of the query when drawn
+    std::size_t count;     // opaque objects drawn under it
+  };
+  std::vector<ConditionalDraw> conditional;
+  // Query q's result is `samples`: settles the draws conditional on it.
+  void settle_conditional(QueryId q, std::uint64_t samples, BackendStats& stats) {
+    std::erase_if(conditional, [&](const ConditionalDraw& d) {
+      if (d.query != q || d.serial != query_serial[q]) return false;
+      if (samples == 0) stats.conditional_skipped += d.count;
+      return true;
+    });
+  }
+  GLuint truth_query = 0;             // GL_SAMPLES_PASSED, for visible_pixels only
+  std::vector<std::uint32_t> pixel_counts;  // per object, scratch of visible_pixels
+  GLuint indirect_buffer = 0;         // multi-draw commands, refilled every frame
+  GLsizeiptr indirect_capacity = 0, indirect_offset = 0;
+  std::vector<detail::DrawCommand> commands;
+
+  Impl(const Scene& s, const RendererOptions& o) : scene(s), options(o) {}
+
+  void create_targets();
+  void create_scene_buffers();
+  void create_query_resources();
+  void apply_draw_buffers() const;
+  void establish_frame_state() const;
+  void prepare_pass(const View& view);
+  std::uint64_t samples_passing(std::span<const ObjectId> ids);
+  void enter_render_state(BackendStats& stats);
+  void enter_query_state(BackendStats& stats);
+  void draw_objects(std::span<const ObjectId> ids, BackendStats& stats);
+  void multi_draw(std::span<const ObjectId> ids);
+  void upload_dynamic_transforms();
+  // `objects` into `opaque` (cleared first) and `translucent` (appended to),
+  // each in the order given.
+  void split_translucent(std::span<const ObjectId> objects, std::vector<ObjectId>& translucent_out);
+  // `opaque` by material, stably (a front-to-back order within a material survives).
+  void sort_opaque_by_material();
+};
+
+
+}  // namespace occull::gl
