@@ -12,7 +12,7 @@
 #pragma once
 
 #include "occull/backend.hpp"
-#include "occull/harness.hpp"
+#include "occull/bench.hpp"
 #include "occull/stats.hpp"
 
 #include <cstdint>

@@ -1,0 +1,341 @@
+// occull — a scene set up on the GL device for runs of frames (Session),
+// the ground truth of a frame and the verification of a culler's frames
+// against it. The harness's bench types are in occull/bench.hpp.
+//
+// Ground truth: an untimed pass per frame renders every object inside the
+// view frustum into the object-id buffer; the truth set is every object with
+// at least one pixel (translucent objects: at least one sample passing the
+// depth test). It depends only on the frame, so it is computed once per
+// frame and shared by every algorithm and repeat.
+//
+// Verification compares what an algorithm rendered in a timed frame with
+// that truth, outside the timed region. An object in the truth set that the
+// algorithm did not render is *missed*. Because the algorithm draws a subset
+// of the objects with the same depth test, every object it did render owns
+// exactly its truth pixels in its own image, so the pixels its image gets
+// wrong are exactly the truth pixels of the missed objects (`wrong_pixels`).
+// Timed frames are identical with and without verification.
+#pragma once
+
+#include "occull/bvh.hpp"
+#include "occull/cost_model.hpp"
+#include "occull/culler.hpp"
+#include "occull/frame_log.hpp"
+#include "occull/recording_backend.hpp"
+#include "occull/gl/context.hpp"
+#include "occull/gl/renderer.hpp"
+#include "occull/scenes.hpp"
+#include "occull/stall_guard.hpp"
+#include "occull/stats.hpp"
+
+#include <functional>
+#include <iosfwd>
+#include <memory>
+#include <optional>
+#include <span>
+#include <string>
+#include <vector>
+
+namespace occull {
+
+namespace detail {
+class Watchdog;    // src/eval/watchdog.hpp
+struct FrameLabel;  // src/eval/invariants.hpp
+}  // namespace detail
+
+/// Where opaque geometry covers an image: one bit per pixel (row-major,
+/// bottom row first, bit i of word i / 64), how many pixels, and a hash of
+/// the depth image (equal hashes: bit-identical depth).
+struct Coverage {
+  std::vector<std::uint64_t> bits;
+  std::uint64_t pixels = 0;
+  std::uint64_t depth_hash = 0;
+};
+
+/// Ground truth of one frame.
+struct FrameTruth {
+  std::vector<gl::Renderer::ObjectPixels> visible;  ///< objects with a visible pixel, sorted by id
+  Coverage coverage;                                ///< of the truth pass's depth image
+  std::uint32_t probes = 0;  ///< triangles the CPU probe (truth-probe) checked in this frame
+};
+
+/// Called as work progresses: a label (algorithm name, or "ground truth"),
+/// the step just done (0-based), the number of steps, and whether it was a
+/// warm-up step. With 0 steps the label is a message line of its own (e.g.
+/// "calibrating the hardware cost model").
+using ProgressFn = std::function<void(std::string_view label, int step, int steps, bool warmup)>;
+
+/// Verification of one frame: fills truth_objects, missed_objects,
+/// wrong_pixels and extra_objects of `stats` from the frame's truth and the
+/// objects the algorithm rendered (duplicates allowed), and returns the
+/// missed ids (ascending). `object_count` is the scene's object count.
+std::vector<ObjectId> check_frame(std::span<const gl::Renderer::ObjectPixels> truth,
+                                  std::span<const ObjectId> rendered, std::size_t object_count,
+                                  FrameStats& stats);
+
+/// The process's memory after a frame of a run (every kMemorySampleFrames).
+struct MemorySample {
+  int frame = 0;        ///< frames of the run done (1000, 2000, ...)
+  double rss_mb = 0.0;  ///< resident set of the process, MiB
+  double gpu_mb = 0.0;  ///< the renderer's buffer objects as GL sizes them, MiB
+};
+/// Frames between two MemorySamples of a run.
+inline constexpr int kMemorySampleFrames = 1000;
+
+/// Frames of one algorithm over a path (one repeat).
+struct AlgorithmRun {
+  std::string name;
+  int repeat = 0;
+  bool conservative = true;  ///< must miss nothing (is_conservative of its spec)
+  std::vector<FrameStats> frames;
+  std::uint32_t longest_miss_frames = 0;  ///< longest run of frames one object stayed missed
+  std::vector<MemorySample> memory;       ///< after every kMemorySampleFrames frames
+  std::string first_miss;                 ///< "frame K: <describe_object>" of the first missed object; empty if none
+};
+
+/// How long objects stay missed over consecutive frames of one run.
+class MissRuns {
+ public:
+  explicit MissRuns(std::size_t objects) : run_(objects, 0) {}
+  /// The missed ids of the next frame (ascending, as check_frame returns them).
+  void add(const std::vector<ObjectId>& missed);
+  /// Longest run of consecutive frames one object stayed missed so far.
+  [[nodiscard]] std::uint32_t longest() const noexcept { return longest_; }
+
+ private:
+  std::vector<std::uint32_t> run_;
+  std::vector<ObjectId> previous_;
+  std::uint32_t longest_ = 0;
+};
+
+/// Fault injection, for tests only: each hook, when set, may corrupt one
+/// step of the instrument, so a test can see the run-time invariant that
+/// guards that step stop the run (a check never seen failing is not trusted).
+struct FaultHooks {
+  /// The objects the truth pass is about to draw (those inside the frustum).
+  std::function<void(std::vector<ObjectId>& drawn)> truth_objects;
+  /// What the truth pass found and the images it read back.
+  std::function<void(std::vector<gl::Renderer::ObjectPixels>& visible, gl::Renderer::PassImages& images)>
+      truth_images;
+  /// The objects the oracle is told to render.
+  std::function<void(std::vector<ObjectId>& visible)> oracle_objects;
+  /// The depth image of a verified frame of an algorithm, as read back.
+  std::function<void(std::vector<float>& depth)> frame_depth;
+};
+
+/// A scene set up on the GL device: the context, the generated scene with
+/// its paths, its BVH and the renderer. Everything a run of frames needs.
+///
+/// Verified runs check the run-time invariants of src/eval/invariants.hpp
+/// on every frame (the truth pass covers what the full scene shows, the
+/// truth is non-empty where anything is drawn, an independent CPU probe of
+/// sampled triangles, every algorithm frame within the truth, the oracle
+/// reproducing it exactly) and throw InvariantViolation on the first that
+/// fails.
+class Session {
+ public:
+  /// Builds the scene from `scene_spec` (throws InputError) and its BVH,
+  /// then creates the GL context (throws GlUnavailable) and the renderer.
+  Session(std::string_view scene_spec, const gl::RendererOptions& renderer_options,
+          const BvhOptions& bvh_options = {}, const gl::ContextOptions& context_options = {});
+  ~Session();
+  Session(const Session&) = delete;
+  Session& operator=(const Session&) = delete;
+
+  /// Replaces the GL context and the renderer by fresh ones, so one
+  /// algorithm's run cannot leave driver state that slows the next (seen on
+  /// llvmpipe: after `perobject`'s thousands of small flushes per frame,
+  /// chc/chcpp in the same context ran 10-20% slower for the rest of the
+  /// process). Costs a fraction of a second.
+  ///
+  /// The replaced context is not destroyed at once: it stays, idle, until
+  /// the next replacement (or the session's end) destroys it. Destroyed
+  /// right after its last frame, llvmpipe's rasterizer threads could still
+  /// be leaving that frame's scene when the context freed it, and about one
+  /// bench in 25-120 died of heap corruption in the next algorithm's first
+  /// frames (docs/performance.md, "A crash in the driver").
+  void reset_renderer();
+
+  /// Runs one frame: moves dynamic objects to `time_s` (untimed), then
+  /// times refit, begin_frame, the culler and end_frame (closed by
+  /// glFinish). Fills every timing and backend counter of the result.
+  /// With `log`, also logs the culler's backend calls into it (the debug
+  /// views; the log costs time of its own): the culler then renders through
+  /// the session's LoggingBackend, a decorator over the same device.
+  FrameStats run_frame(Culler& culler, const View& view, double time_s, FrameLog* log = nullptr);
+
+  /// Hands back every query `culler` holds (Culler::release) through the
+  /// session's backend. Call it when a culler's run ends, before the culler
+  /// goes and before reset_renderer().
+  void release(Culler& culler);
+  /// The run-time invariant "queries-returned": the renderer has no query in
+  /// flight but those the stall guard gave up on. Call it once every culler
+  /// of a run was released; throws InvariantViolation naming `who` otherwise.
+  void check_queries_returned(std::string_view who) const;
+
+  /// The ground truth of frames 0..frames-1 of `path` (untimed), each
+  /// frame checked by the truth invariants. Throws InvariantViolation.
+  [[nodiscard]] std::vector<FrameTruth> ground_truth(const CameraPath& path, int frames,
+                                                     const ProgressFn& progress = {});
+  /// The ground truth of frame k of `frames` along `path` alone (untimed;
+  /// moves the scene to that frame's time), checked as ground_truth()'s.
+  /// Overwrites the renderer's targets.
+  [[nodiscard]] FrameTruth truth_at(const CameraPath& path, int k, int frames);
+  /// The ground truth of `view` over the scene as it stands (a free camera:
+  /// occull view), checked as ground_truth()'s. Overwrites the renderer's targets.
+  [[nodiscard]] FrameTruth truth_of(const View& view);
+
+  /// Test hooks (see FaultHooks); empty by default.
+  void set_fault_hooks(FaultHooks hooks) { hooks_ = std::move(hooks); }
+
+  /// Makes a culler from an algorithm spec ("chcpp" or
+  /// "chcpp:multiquery=off", see parse_algorithm_spec) for this scene;
+  /// `oracle` too (run_path feeds it the truth). A culler that needs nohc's
+  /// hardware profile and is given no file gets hardware_profile(), which
+  /// calibrates on first use (its lines go to `progress`). Throws
+  /// InputError like make_culler().
+  [[nodiscard]] std::unique_ptr<Culler> make(std::string_view spec, const Options& options,
+                                             const std::function<void(const std::string&)>& progress = {});
+  /// What cullers made for this session get: nohc's profile from
+  /// hardware_profile() (calibrated on first use, its lines to `progress`).
+  /// Valid while the session lives.
+  [[nodiscard]] CullerContext culler_context(const std::function<void(const std::string&)>& progress = {});
+  /// Whether hardware_profile() has been loaded or calibrated in this session.
+  [[nodiscard]] bool has_hardware_profile() const noexcept { return profile_.has_value(); }
+
+  /// Runs frame k of `frames` along `path` (feeding the oracle that
+  /// frame's truth; it needs `truth`). Timings as run_frame.
+  FrameStats run_path_frame(Culler& culler, const CameraPath& path, int k, int frames,
+                            const std::vector<FrameTruth>* truth);
+
+  /// Checks the frame `culler` just ran (frame k of `path`) against its
+  /// truth, outside the timed region: frame-within-truth, and
+  /// oracle-draws-truth for the oracle (throw InvariantViolation); fills
+  /// the verification figures of `stats` and returns the missed ids.
+  std::vector<ObjectId> verify_frame(std::string_view name, const Culler& culler, const CameraPath& path, int k,
+                                     const FrameTruth& truth, FrameStats& stats);
+  /// What object `id` is now, for a person: "tile city-3 at (0, -97),
+  /// object 12" in a tiled world (its ids are reused as the window moves),
+  /// else "object 812 (mesh 5)".
+  [[nodiscard]] std::string describe_object(ObjectId id) const;
+  /// The process's memory now, as the sample after `frame` frames of a run.
+  [[nodiscard]] MemorySample memory_sample(int frame) const;
+
+  /// Runs `culler` over frames 0..frames-1 of `path`. With `truth` (one
+  /// entry per frame), checks every frame against it (frame-within-truth,
+  /// and oracle-draws-truth for the oracle; the oracle needs it); throws
+  /// InvariantViolation. With `predict`, also fills FrameStats::model_ms
+  /// (see predicted_frame_ms).
+  AlgorithmRun run_path(std::string_view name, Culler& culler, const CameraPath& path, int frames,
+                        const std::vector<FrameTruth>* truth, const ProgressFn& progress = {},
+                        bool predict = false);
+
+  /// The NOHC hardware profile of this renderer: loaded from the per-user
+  /// cache (default_profile_path), or calibrated now — a few seconds — and
+  /// cached. Throws InputError when the cached file is corrupt.
+  const HardwareProfile& hardware_profile(const std::function<void(const std::string&)>& progress = {});
+  /// Where hardware_profile() reads and writes the profile.
+  [[nodiscard]] std::string hardware_profile_path() const;
+  /// "renderer | version": the key profiles are cached under.
+  [[nodiscard]] std::string renderer_key() const;
+
+  /// The cost model's estimate of the frame just run: t_r of every object
+  /// rendered plus t_o of every query issued (milliseconds).
+  [[nodiscard]] double predicted_frame_ms(const View& view);
+
+  /// The named camera path of the scene (empty: its first), or a recorded
+  /// one for "file:PATH" (read_path_file). Throws InputError listing the
+  /// valid names, or naming what is wrong in the file.
+  const CameraPath& path(std::string_view name);
+
+  /// Bounds every frame (a culler's, or one of the ground truth) to this
+  /// many seconds of wall time: past it, the process says which frame hung
+  /// and exits with 1 (a GL call that never returns cannot be unwound).
+  /// 0 turns it off. Default: kWatchdogSeconds. Throws InputError for a
+  /// negative or non-finite time.
+  void set_watchdog(double seconds);
+  static constexpr double kWatchdogSeconds = 300.0;
+
+  /// Culler frames get the renderer through a StallGuard of this many
+  /// milliseconds (0, the default: none, results are waited for).
+  /// Throws InputError for a negative or non-finite time.
+  void set_stall_guard(double timeout_ms);
+  /// What culler frames render through: the renderer under the session's
+  /// RecordingBackend, and over both the StallGuard when one is set.
+  [[nodiscard]] Backend& backend() noexcept;
+  /// What the last culler frame drew and queried (run_frame() starts and
+  /// finishes the record with the frame).
+  [[nodiscard]] const RecordingBackend& recording() const noexcept { return *recorder_; }
+
+  /// Where frames lie on paths (default: spread over the whole path).
+  void set_sampling(const FrameSampling& sampling) { sampling_ = sampling; }
+  /// How the scene's lens projects from now on (--depth): OpenGL's standard
+  /// depth, or reversed-Z with an infinite far plane. The renderer, the
+  /// ground truth and the verifier follow each view's conventions.
+  /// Throws InputError for reversed depth on a tiled world (its window of
+  /// tiles is sized by a finite far plane).
+  void set_depth(DepthMode depth);
+  /// Objects moved by the engine, for benchmarks (--engine-moves): from now
+  /// on, before every frame and its truth, `fraction` of the static objects
+  /// (every round(1 / fraction)-th; 0: none) are moved with
+  /// Scene::set_transform, not a Motion, around small circles (2 scene units
+  /// across, one turn in 4 s of path time) about where they stood, as an
+  /// engine's game logic would; the hierarchy follows in run_frame().
+  /// Throws InputError for a fraction outside [0, 1] or on a tiled world.
+  void set_engine_moves(double fraction);
+  [[nodiscard]] const FrameSampling& sampling() const noexcept { return sampling_; }
+  /// Path time of frame k of `frames` under the session's sampling.
+  [[nodiscard]] double frame_time(const CameraPath& path, int k, int frames) const {
+    return path.frame_time(k, frames, sampling_);
+  }
+  /// View of `path` at frame k of `frames`.
+  [[nodiscard]] View view_at(const CameraPath& path, int k, int frames) const;
+
+  [[nodiscard]] const SceneBundle& bundle() const noexcept { return bundle_; }
+  /// The scene, for an engine's changes between frames (set_transform,
+  /// remove_object, add_object reusing removed ids): run_frame() refits the
+  /// hierarchy to them. The renderer refuses objects added past the count
+  /// the scene had when it was made.
+  [[nodiscard]] Scene& scene() noexcept { return bundle_.scene; }
+  [[nodiscard]] SceneIndex index() const noexcept { return {bundle_.scene, bvh_, bundle_.world.get()}; }
+  [[nodiscard]] gl::Renderer& renderer() noexcept { return *renderer_; }
+  [[nodiscard]] gl::Context& context() noexcept { return *context_; }
+  [[nodiscard]] const gl::DeviceInfo& device() const noexcept { return device_; }
+  [[nodiscard]] double scene_build_ms() const noexcept { return scene_build_ms_; }
+  [[nodiscard]] double bvh_build_ms() const noexcept { return bvh_build_ms_; }
+  [[nodiscard]] const Bvh& bvh() const noexcept { return bvh_; }
+
+ private:
+  // Declared (so initialised) before bundle_, which records into it.
+  double scene_build_ms_ = 0.0;
+  double bvh_build_ms_ = 0.0;
+  std::string scene_spec_;
+  SceneBundle bundle_;
+  std::vector<ObjectId> engine_moved_;      // set_engine_moves: the objects moved
+  std::vector<glm::mat4> engine_home_;      // ... and where they stood
+  // The scene at path time `time_s`: Motions, then the engine's moves.
+  void advance_scene(double time_s);
+  Bvh bvh_;
+  std::unique_ptr<gl::Context> retired_;  // the context reset_renderer() replaced last, idle (see there)
+  std::unique_ptr<gl::Context> context_;
+  gl::DeviceInfo device_;
+  gl::RendererOptions renderer_options_;
+  gl::ContextOptions context_options_;
+  std::unique_ptr<gl::Renderer> renderer_;
+  double stall_guard_ms_ = 0.0;
+  // The backend chain of culler frames: renderer_ <- recorder_ (what the
+  // frame drew and queried, for verification and the cost model) <- guard_
+  // (with a stall guard) <- logger_ (logged frames). Each goes before what
+  // it wraps.
+  std::unique_ptr<RecordingBackend> recorder_;
+  std::unique_ptr<StallGuard> guard_;
+  void wrap_renderer();  // (re)builds recorder_ and guard_ over renderer_
+  std::unique_ptr<LoggingBackend> logger_;  // over backend(), for logged frames; goes before both
+  std::unique_ptr<detail::Watchdog> watchdog_;
+  std::optional<HardwareProfile> profile_;
+  FaultHooks hooks_;
+  FrameTruth truth_of(const View& view, const detail::FrameLabel& where);
+  FrameSampling sampling_;
+};
+
+}  // namespace occull
