@@ -14,6 +14,7 @@
 #include <fstream>
 #include <ostream>
 #include <sstream>
+#include <type_traits>
 
 namespace occull {
 namespace {

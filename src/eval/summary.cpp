@@ -9,6 +9,7 @@
 #include <cmath>
 #include <map>
 #include <numeric>
+#include <type_traits>
 
 namespace occull {
 namespace {
