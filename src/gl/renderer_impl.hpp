@@ -1,6 +1,7 @@
-// The reference renderer's state, shared by its files: renderer.cpp (the
-// scene resources and the Backend's frame passes) and renderer_truth.cpp
-// (the untimed truth pass and the read-backs over the same resources).
+// The reference renderer's state, shared by its files by job:
+// renderer_resources.cpp (programs, buffers, targets), renderer.cpp (the
+// Backend's frame passes) and renderer_truth.cpp (the untimed truth pass
+// and the read-backs over the same resources).
 // Internal to occull_gl.
 #pragma once
 
@@ -30,7 +31,10 @@ struct DrawCommand {
   GLuint base_instance;
 };
 
-constexpr QueryId kNoQuery = ~QueryId(0);  // boxes per stream-buffer fill
+// Boxes per fill of the query-box stream buffer.
+constexpr GLsizeiptr kBoxCapacity = 1 << 16;
+
+constexpr QueryId kNoQuery = ~QueryId(0);  // no query: flush() is not about one
 
 }  // namespace detail
 
