@@ -13,6 +13,9 @@ packages=(
   # libraries
   libglm-dev libfmt-dev libcli11-dev nlohmann-json3-dev libstb-dev libtinyxml2-dev
   libminizip-dev libassimp-dev
+  # OpenSceneGraph: occull_osg (a culling group inside OSG) and `occull osg`, which measures it
+  # beside OSG's own osg::OcclusionQueryNode in one viewer; openscenegraph brings its file plugins
+  libopenscenegraph-dev openscenegraph
   # occull view: a window (GLFW) with Dear ImGui; tested under a virtual X server
   libglfw3-dev libimgui-dev xvfb xauth
   # tests and benchmarks

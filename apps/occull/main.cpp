@@ -15,6 +15,11 @@
 #include "occull/profile_io.hpp"
 #include "occull/q3bsp.hpp"
 #include "occull/harness.hpp"
+#ifdef OCCULL_OSG
+#include "occull/osg/osg_bench.hpp"
+#include "occull/osg/scene_graph.hpp"
+#include <osgDB/WriteFile>
+#endif
 #include "occull/input_limits.hpp"
 #include "occull/report.hpp"
 #include "occull/scenes.hpp"
@@ -387,6 +392,61 @@ int cmd_bench(const BenchArgs& a) {
   // A conservative culler that misses a visible object is broken, whatever its frame time.
   return occull::verification_failures(result).empty() ? 0 : kExitVerificationFailed;
 }
+
+#ifdef OCCULL_OSG
+struct OsgArgs {
+  BenchArgs run;  // scene, path, frames, warmup, fps, start, size, opts, repeat, verify, json, report
+  std::string rows;
+  std::string threading = "single";
+  std::string export_file;
+};
+
+// `osg`: occull's cullers inside OpenSceneGraph beside OSG's OcclusionQueryNode.
+int cmd_osg(const OsgArgs& a) {
+  const BenchArgs& r = a.run;
+  if (!a.export_file.empty()) {
+    const occull::SceneBundle bundle = occull::make_scene(r.scene);
+    const osgOccull::ExportedScene exported = osgOccull::export_scene(bundle.scene);
+    if (!osgDB::writeNodeFile(*exported.root, a.export_file))
+      throw occull::InputError(fmt::format("{}: OpenSceneGraph cannot write it (no plugin for its extension, or "
+                                           "the folder is not writable)", a.export_file));
+    std::fprintf(stderr, "exported %s (%zu objects) to %s\n", r.scene.c_str(), bundle.scene.objects().size(),
+                 a.export_file.c_str());
+    return 0;
+  }
+  osgOccull::OsgBenchConfig c;
+  c.scene = r.scene;
+  c.path = r.path;
+  c.rows = split_list(a.rows);
+  c.frames = r.frames;
+  c.warmup = r.warmup;
+  c.repeat = r.repeat;
+  c.sampling = {r.fps, r.start};
+  const Size size = parse_size(r.size);
+  c.width = size.width;
+  c.height = size.height;
+  c.verify = parse_on_off("--verify", r.verify);
+  c.threading = a.threading;
+  c.options = parse_options(r.opts);
+  const bool report = !r.no_report && !r.report.empty();
+  const auto json = open_output(r.json);
+  if (report) occull::prepare_report_folder(r.report);
+  Progress progress;
+  const auto result = osgOccull::run_osg_bench(c, std::ref(progress));
+  occull::print_table(result, std::cout);
+  std::cout.flush();
+  if (json) {
+    occull::write_json(result, *json);
+    json->flush();
+    check_written(*json, r.json);
+  }
+  if (report) {
+    const auto files = occull::write_report(result, r.report);
+    std::fprintf(stderr, "report: %s/report.md (%zu files)\n", r.report.c_str(), files.size());
+  }
+  return occull::verification_failures(result).empty() ? 0 : kExitVerificationFailed;
+}
+#endif
 
 struct SweepArgs {
   BenchArgs bench;  // scene, path, frames, size, ...; bench.algos holds the algorithm
@@ -896,6 +956,25 @@ int main(int argc, char** argv) {
                 "around 2 m circles; the hierarchy and the cullers follow")
       ->capture_default_str();
 
+#ifdef OCCULL_OSG
+  OsgArgs osg_args;
+  osg_args.run.report.clear();
+  auto* og = app.add_subcommand(
+      "osg", "occull's cullers inside OpenSceneGraph beside OSG's own OcclusionQueryNode, in one headless OSG "
+             "viewer, every frame checked against occull's ground truth");
+  add_run_options(og, osg_args.run, "row");
+  og->add_option("--rows", osg_args.rows,
+                 "comma-separated rows (default: osg,oqn,oqn-strict,vfc,chcpp,nohc,grid):\n" +
+                     osgOccull::describe_osg_rows());
+  og->add_option("--threading", osg_args.threading,
+                 "osgViewer threading model: single (SingleThreaded) or cull-draw (CullDrawThreadPerContext); "
+                 "the models that draw while the next frame is culled are refused")
+      ->capture_default_str();
+  og->add_option("--report", osg_args.run.report, "write report.md, SVG charts, JSON and CSV into this folder");
+  og->add_option("--export", osg_args.export_file,
+                 "write the scene as an OSG file (.osgt, .osgb, .ive, ...: any format OSG writes) and exit");
+#endif
+
   SweepArgs sweep;
   sweep.bench.algos = "grid";
   sweep.bench.frames = 60;
@@ -1057,6 +1136,9 @@ int main(int argc, char** argv) {
     if (cmd == "algos") return cmd_algos();
     if (cmd == "bench") return cmd_bench(bench);
     if (cmd == "sweep") return cmd_sweep(sweep);
+#ifdef OCCULL_OSG
+    if (cmd == "osg") return cmd_osg(osg_args);
+#endif
     if (cmd == "render") return cmd_render(render);
     if (cmd == "calibrate") return cmd_calibrate(calibrate);
     if (cmd == "traverse") return cmd_traverse(traverse);

@@ -115,15 +115,17 @@ std::unique_ptr<Context> Context::create(const ContextOptions& options) {
   }
   const EGLint context_attribs[] = {EGL_CONTEXT_MAJOR_VERSION,       4,
                                     EGL_CONTEXT_MINOR_VERSION,       5,
-                                    EGL_CONTEXT_OPENGL_PROFILE_MASK, EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT,
+                                    EGL_CONTEXT_OPENGL_PROFILE_MASK,
+                                    options.compatibility ? EGL_CONTEXT_OPENGL_COMPATIBILITY_PROFILE_BIT
+                                                          : EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT,
                                     EGL_CONTEXT_OPENGL_DEBUG,        self->debug_ ? EGL_TRUE : EGL_FALSE,
                                     EGL_NONE};
   EGLContext context = eglCreateContext(display, config, EGL_NO_CONTEXT, context_attribs);
   if (context == EGL_NO_CONTEXT)
     throw GlUnavailable(fmt::format(
-        "the driver cannot create an OpenGL 4.5 core context (EGL error 0x{:x}); occull needs "
+        "the driver cannot create an OpenGL 4.5 {} context (EGL error 0x{:x}); occull needs "
         "OpenGL 4.5: Mesa 20 or newer (llvmpipe works) or a GPU driver",
-        eglGetError()));
+        options.compatibility ? "compatibility" : "core", eglGetError()));
   self->context_ = context;
   if (!eglMakeCurrent(display, EGL_NO_SURFACE, EGL_NO_SURFACE, context))
     throw GlUnavailable(fmt::format(

@@ -1,4 +1,5 @@
-// occull — a headless OpenGL 4.5 core context (EGL, no window, no X server).
+// occull — a headless OpenGL 4.5 context (EGL, no window, no X server), core
+// profile unless asked for compatibility.
 #pragma once
 
 #include <array>
@@ -33,9 +34,13 @@ struct ContextOptions {
   /// GlError. Costs driver time: off for benchmarks. Always on in a debug
   /// build of occull (NDEBUG not defined when the library was compiled).
   bool debug = false;
+  /// A compatibility-profile context (fixed-function calls allowed) instead
+  /// of a core one: for renderers that need it, such as Debian's
+  /// OpenSceneGraph (built for OpenGL 2 and its fixed-function pipeline).
+  bool compatibility = false;
 };
 
-/// Owns an OpenGL 4.5 core context on the process's headless EGL display,
+/// Owns an OpenGL 4.5 context (ContextOptions: core or compatibility) on the process's headless EGL display,
 /// current on the creating thread for the object's lifetime. Not copyable;
 /// one per thread. The display stays initialised after the last Context is
 /// gone (see ~Context): the driver is loaded once per process.

@@ -1,0 +1,141 @@
+// occull inside OpenSceneGraph (namespace osgOccull, as OSG's own osgUtil, osgShadow, ...): a group node whose subgraph an occull culler
+// culls, in OSG's own viewer, drawn by OSG's own state machinery.
+//
+// Put the part of the scene graph worth occlusion culling under an
+// OcclusionCullingGroup (as one would put it under osg::OcclusionQueryNode):
+//
+//   osg::ref_ptr<osgOccull::OcclusionCullingGroup> group =
+//       new osgOccull::OcclusionCullingGroup("chcpp");
+//   group->addChild(city);            // anything: transforms, geodes, LODs' chosen child, ...
+//   root->addChild(group);
+//   viewer.setSceneData(root);        // threading: SingleThreaded or CullDrawThreadPerContext (below)
+//
+// How it works. Each frame's first cull traversal that reaches the group
+// walks its subgraph and keeps an occull Scene of what it finds: one object
+// per drawable instance (a drawable under two transforms is two objects of
+// one mesh: shared geometry stays shared), its box from the drawable's
+// bounding box and the transforms above it (no vertex is copied), moved,
+// added and removed as the graph changes; the hierarchy (Bvh) is refitted to
+// it. OSG's cull traversal does not descend below the group: it files one
+// drawable of the group's own instead, and in the draw traversal that
+// drawable runs the culler of the camera being drawn (one culler per camera,
+// made on its first frame) through a Backend over OSG's osg::State: objects
+// are drawn by Drawable::draw with the state sets on their path applied,
+// queries are boxes drawn with a state set of the group's (no colour or
+// depth writes, depth clamp, both faces, offset toward the eye) inside GL
+// occlusion queries on the camera's context. The view is the one the draw
+// uses: the model-view matrix at the group and the projection OSG applied.
+//
+// What applies inside the group: occull's culling. OSG's own frustum and
+// small-feature culling stop at the group's boundary (it keeps the group's
+// drawable from being culled); outside the group everything is as before.
+// Translucent drawables (a state set with the transparent bin, or blending
+// on) never occlude; they are drawn after the group's opaque ones, back to
+// front. LOD and Switch nodes contribute the children active when the scene
+// is gathered (the first cull of the frame; LODs: their nearest range).
+//
+// Threading. Supported: osgViewer's SingleThreaded and
+// CullDrawThreadPerContext models (a frame's update, cull and draw never
+// overlap the next frame's). DrawThreadPerContext and
+// CullThreadPerCameraDrawThreadPerContext draw a frame while the next one is
+// updated and culled: the group would read a graph being changed under it,
+// and refuses them: its cull throws UnsupportedThreading (call
+// require_supported_threading() before the first frame to hear it early).
+//
+// Queries are owned: releaseGLObjects(state) (OSG calls it when a context
+// closes) hands back the queries of that context's cullers and deletes its
+// query objects; a group destroyed with its contexts already gone drops them.
+#pragma once
+
+#include "occull/culler.hpp"
+#include "occull/error.hpp"
+#include "occull/backend.hpp"
+#include "occull/stats.hpp"
+
+#include <osg/Group>
+#include <osg/NodeVisitor>
+#include <osgViewer/ViewerBase>
+
+#include <memory>
+#include <mutex>
+#include <span>
+#include <string>
+#include <vector>
+
+namespace osgOccull {
+
+/// A threading model the group cannot run under (see the file comment).
+class UnsupportedThreading : public occull::InputError {
+ public:
+  using occull::InputError::InputError;
+};
+
+/// Throws UnsupportedThreading, naming the model and the supported ones,
+/// when `viewer` runs (or, for AutomaticSelection, would choose) a threading
+/// model other than SingleThreaded or CullDrawThreadPerContext.
+void require_supported_threading(osgViewer::ViewerBase& viewer);
+
+/// One drawable instance the group culls: an occull object.
+struct Instance {
+  ::osg::ref_ptr<::osg::Drawable> drawable;
+  ::osg::NodePath path;                      ///< from below the group down to the drawable's geode (or the drawable)
+  ::osg::Matrix to_group;                    ///< local to the group's coordinates
+  ::osg::ref_ptr<::osg::StateSet> state;     ///< the state sets on the path, merged (null: none)
+  bool translucent = false;
+};
+
+/// What one camera's culler did in its last frame.
+struct CameraFrame {
+  std::vector<occull::ObjectId> drawn;  ///< objects drawn (ascending; ids of instances())
+  occull::FrameStats culler;            ///< the culler's own counters; cpu_ms: its time outside backend calls, ms
+  occull::BackendStats backend;         ///< what the backend counted in the frame (draws, queries, waits, ...)
+};
+
+class OcclusionCullingGroup : public ::osg::Group {
+ public:
+  /// `algorithm`: an occull algorithm spec ("chcpp", "grid:cap=200", ...;
+  /// `occull algos` lists them), made per camera with `options` and
+  /// `context` (nohc needs a hardware profile there). The spec is checked
+  /// here: throws occull::InputError for an unknown one, listing the valid names.
+  explicit OcclusionCullingGroup(std::string algorithm = "chcpp", occull::Options options = {},
+                                 occull::CullerContext context = {});
+  OcclusionCullingGroup(const OcclusionCullingGroup&, const ::osg::CopyOp& = ::osg::CopyOp::SHALLOW_COPY);
+  META_Node(occull, OcclusionCullingGroup)
+
+  /// The algorithm of the cullers made from now on (cameras seen before keep
+  /// theirs until releaseGLObjects). Throws occull::InputError as the constructor.
+  void set_algorithm(std::string algorithm, occull::Options options = {});
+  [[nodiscard]] const std::string& algorithm() const noexcept { return algorithm_; }
+
+  void traverse(::osg::NodeVisitor& nv) override;
+  ::osg::BoundingSphere computeBound() const override;
+  void releaseGLObjects(::osg::State* state = nullptr) const override;
+
+  /// The objects as gathered in the last frame (index = occull::ObjectId; an entry
+  /// with a null drawable is a removed object's empty slot).
+  [[nodiscard]] std::span<const Instance> instances() const noexcept { return instances_; }
+  /// The occull scene of them (boxes, triangle counts, classes), in the
+  /// group's coordinates.
+  [[nodiscard]] const occull::Scene& scene() const noexcept;
+  /// What `camera` drew in its last frame; null for a camera never drawn.
+  [[nodiscard]] const CameraFrame* last_frame(const ::osg::Camera* camera) const;
+
+ protected:
+  ~OcclusionCullingGroup() override;
+
+ private:
+  struct State;       // the scene, hierarchy and per-camera cullers
+  class Drawer;       // the drawable filed in the cull traversal; runs the culler in the draw
+  friend class Drawer;
+  std::string algorithm_;
+  occull::Options options_;
+  occull::CullerContext context_;
+  std::vector<Instance> instances_;
+  std::shared_ptr<State> state_;
+  ::osg::ref_ptr<::osg::Geode> drawer_geode_;
+  std::mutex mutex_;  // gathering and per-camera state: cull and draw threads of several contexts
+  void gather(unsigned frame_number);
+  void draw(::osg::RenderInfo& info);
+};
+
+}  // namespace osgOccull

@@ -1,0 +1,54 @@
+// `occull osg`: occull's cullers inside OpenSceneGraph beside OSG's own
+// osg::OcclusionQueryNode, in one OSG viewer, every frame checked against
+// occull's ground truth.
+#pragma once
+
+#include "occull/bench.hpp"
+
+#include <string>
+#include <vector>
+
+namespace osgOccull {
+
+/// The rows `occull osg` runs when none are named: OSG without occlusion
+/// culling, OcclusionQueryNode with its defaults and strict, occull's vfc,
+/// chcpp, nohc and grid inside an OcclusionCullingGroup.
+[[nodiscard]] const std::vector<std::string>& default_osg_rows();
+
+/// What the OSG rows mean, one line each (`occull osg --help`, the docs).
+[[nodiscard]] std::string describe_osg_rows();
+
+struct OsgBenchConfig {
+  std::string scene = "city";  ///< occull scene spec (exported to an OSG graph: export_scene)
+  std::string path;            ///< camera path; empty = the scene's first
+  /// Rows: "osg" (OSG's frustum and small-feature culling only), "oqn"
+  /// (an osg::OcclusionQueryNode over every object, OSG's defaults: 500
+  /// pixels visibility threshold, a query every 5 frames), "oqn-strict"
+  /// (threshold 0, a query every frame), or an occull algorithm spec run by
+  /// an OcclusionCullingGroup over the whole scene. Empty: default_osg_rows().
+  std::vector<std::string> rows;
+  int frames = 100;            ///< timed frames per row and repeat, >= 1
+  int warmup = 8;              ///< untimed frames first, >= 0
+  int repeat = 1;              ///< runs of every row, interleaved, >= 1
+  occull::FrameSampling sampling;
+  int width = 1280, height = 720;
+  bool verify = true;          ///< check every frame against occull's ground truth
+  /// osgViewer's threading model: "single" (SingleThreaded) or "cull-draw"
+  /// (CullDrawThreadPerContext); the others are refused (see culling_group.hpp).
+  std::string threading = "single";
+  occull::Options options;     ///< base options of the occull rows
+};
+
+/// Runs every row over the same frames: per row and repeat a fresh
+/// compatibility-profile context, a fresh export of the scene and a fresh
+/// headless osgViewer::Viewer embedded in it (an FBO of width x height),
+/// the camera's matrices set from the path's view each frame (near and far
+/// not recomputed by OSG), each frame timed from viewer.frame() to glFinish.
+/// What a row drew in a frame is what reached OSG's draw: for OSG's rows the
+/// objects its cull traversal kept (a cull callback per object), for occull's
+/// the objects the group's culler drew. Throws occull::InputError for an
+/// unknown row, scene, path or threading model (listing the valid ones).
+[[nodiscard]] occull::BenchResult run_osg_bench(const OsgBenchConfig& config,
+                                                const occull::ProgressFn& progress = {});
+
+}  // namespace osgOccull
