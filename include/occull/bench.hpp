@@ -148,6 +148,12 @@ struct BenchResult {
   std::vector<AlgorithmSummary> summaries;   ///< one per algorithm, in the order asked
 };
 
+/// Fills what `r` says of the run before its rows: device, commit, path,
+/// object, triangle and node counts, build times, frames and the session's
+/// sampling, path duration, and how far the camera moves and turns from one
+/// frame to the next.
+void describe_run(const Session& session, const CameraPath& path, int frames, BenchResult& r);
+
 /// The conservative algorithms of a verified result that missed a visible
 /// object (empty when verification passed or did not run).
 [[nodiscard]] std::vector<const AlgorithmSummary*> verification_failures(const BenchResult& result);

@@ -33,6 +33,21 @@ void measure_camera_motion(const Session& session, const CameraPath& path, int f
 
 }  // namespace
 
+void describe_run(const Session& session, const CameraPath& path, int frames, BenchResult& r) {
+  r.device = session.device();
+  r.commit = OCCULL_COMMIT;
+  r.path = path.name();
+  r.objects = session.bundle().scene.objects().size();
+  r.triangles = session.bundle().scene.triangle_count();
+  r.bvh_nodes = session.bvh().size();
+  r.scene_build_ms = session.scene_build_ms();
+  r.bvh_build_ms = session.bvh_build_ms();
+  r.frames = frames;
+  r.sampling = session.sampling();
+  r.path_duration_s = path.duration();
+  measure_camera_motion(session, path, frames, r);
+}
+
 namespace {
 
 // The views of a run of frames: a culler, a path and (verified runs) the
@@ -258,14 +273,9 @@ BenchResult run_bench(const BenchConfig& config, const ProgressFn& progress) {
       profile_path = spec.options.values().at("nohc.profile");
 
   BenchResult result;
-  result.device = session.device();
-  result.commit = OCCULL_COMMIT;
+  describe_run(session, path, config.frames, result);
   result.scene = config.scene;
-  result.path = path.name();
   for (std::size_t k = 1; k < paths.size(); ++k) result.path += " | " + paths[k]->name();
-  result.objects = session.bundle().scene.objects().size();
-  result.triangles = session.bundle().scene.triangle_count();
-  result.bvh_nodes = session.bvh().size();
   if (const TiledWorld* w = session.bundle().world.get()) {
     std::size_t nodes = 0;
     double build_ms = 0.0;
@@ -280,12 +290,6 @@ BenchResult run_bench(const BenchConfig& config, const ProgressFn& progress) {
         "the eye; tile BVHs {} nodes in all, built in {:.1f} ms",
         w->tiles().size(), w->cell_size(), box.x, box.y, box.z, side, side, nodes, build_ms);
   }
-  result.scene_build_ms = session.scene_build_ms();
-  result.bvh_build_ms = session.bvh_build_ms();
-  result.frames = config.frames;
-  result.sampling = config.sampling;
-  result.path_duration_s = path.duration();
-  measure_camera_motion(session, path, config.frames, result);
   result.warmup = config.warmup;
   result.repeat = config.repeat;
   result.verified = config.verify;

@@ -7,7 +7,9 @@
 #include "osg_backend.hpp"
 
 #include <osg/BlendFunc>
+#include <osg/Camera>
 #include <osg/Geode>
+#include <osg/Projection>
 #include <osg/TriangleFunctor>
 #include <osgUtil/CullVisitor>
 #include <osgViewer/View>
@@ -95,6 +97,10 @@ class Gatherer : public ::osg::NodeVisitor {
     matrix_ = saved;
     pop(t);
   }
+  // A camera (render to texture, a HUD) or a projection draws its subgraph
+  // with a view of its own, which a culler of this group's view cannot judge.
+  void apply(::osg::Camera& c) override { refuse(c, "osg::Camera"); }
+  void apply(::osg::Projection& p) override { refuse(p, "osg::Projection"); }
   void apply(::osg::Drawable& d) override {
     push(d);
     found.push_back({&d, getNodePath(), matrix_, states_});
@@ -104,6 +110,15 @@ class Gatherer : public ::osg::NodeVisitor {
  private:
   ::osg::Matrix matrix_;
   std::vector<const ::osg::StateSet*> states_;
+  [[noreturn]] void refuse(::osg::Node& n, const char* kind) {
+    std::string where;
+    for (const ::osg::Node* p : getNodePath())
+      where += fmt::format("{}{}", where.empty() ? "" : " > ", p->getName().empty() ? p->className() : p->getName());
+    throw UnsupportedNode(fmt::format(
+        "OcclusionCullingGroup: cannot cull below a {} ('{}', at {}): it draws its subgraph with a view of its own; "
+        "put it outside the group",
+        kind, n.getName(), where));
+  }
   void push(::osg::Node& n) {
     if (n.getStateSet() != nullptr) states_.push_back(n.getStateSet());
   }

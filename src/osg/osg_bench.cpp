@@ -47,35 +47,6 @@ class KeptRecorder : public ::osg::NodeCallback {
   std::vector<ObjectId>& kept_;
 };
 
-// The device of one row: a compatibility context (Debian's OSG draws with
-// the fixed-function pipeline) and the FBO the embedded viewer draws into.
-struct Device {
-  std::unique_ptr<gl::Context> context;
-  GLuint fbo = 0, colour = 0, depth = 0;
-  Device(int width, int height) : context(gl::Context::create({.debug = false, .compatibility = true})) {
-    glGenFramebuffers(1, &fbo);
-    glGenRenderbuffers(1, &colour);
-    glGenRenderbuffers(1, &depth);
-    glBindRenderbuffer(GL_RENDERBUFFER, colour);
-    glRenderbufferStorage(GL_RENDERBUFFER, GL_RGBA8, width, height);
-    glBindRenderbuffer(GL_RENDERBUFFER, depth);
-    glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT24, width, height);
-    glBindFramebuffer(GL_FRAMEBUFFER, fbo);
-    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, colour);
-    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, depth);
-    if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
-      throw GlUnavailable("occull osg: the driver cannot make a colour + depth framebuffer");
-  }
-  ~Device() {
-    context->make_current();
-    glDeleteFramebuffers(1, &fbo);
-    glDeleteRenderbuffers(1, &colour);
-    glDeleteRenderbuffers(1, &depth);
-  }
-  Device(const Device&) = delete;
-  Device& operator=(const Device&) = delete;
-};
-
 osgViewer::ViewerBase::ThreadingModel threading_model(const std::string& name) {
   if (name == "single") return osgViewer::ViewerBase::SingleThreaded;
   if (name == "cull-draw") return osgViewer::ViewerBase::CullDrawThreadPerContext;
@@ -136,6 +107,90 @@ void drawn_by_group(const OcclusionCullingGroup& group, const ::osg::Camera* cam
 
 }  // namespace
 
+namespace {
+
+// An embedded window whose context is ours: OSG's draw thread (threaded
+// models) makes it current there, and a "swap" finishes the frame (glFinish),
+// so viewer.frame() returns with the frame done in every threading model.
+class EglWindow : public osgViewer::GraphicsWindowEmbedded {
+ public:
+  EglWindow(gl::Context& context, int width, int height)
+      : osgViewer::GraphicsWindowEmbedded(0, 0, width, height), context_(context) {}
+  bool makeCurrentImplementation() override {
+    context_.make_current();
+    return true;
+  }
+  bool releaseContextImplementation() override {
+    context_.release();
+    return true;
+  }
+  void swapBuffersImplementation() override { glFinish(); }
+
+ private:
+  gl::Context& context_;
+};
+
+}  // namespace
+
+HeadlessViewer::HeadlessViewer(int width, int height, osgViewer::ViewerBase::ThreadingModel model)
+    : context_(gl::Context::create({.debug = false, .compatibility = true})) {
+  glGenFramebuffers(1, &fbo_);
+  glGenRenderbuffers(2, renderbuffers_);
+  glBindRenderbuffer(GL_RENDERBUFFER, renderbuffers_[0]);
+  glRenderbufferStorage(GL_RENDERBUFFER, GL_RGBA8, width, height);
+  glBindRenderbuffer(GL_RENDERBUFFER, renderbuffers_[1]);
+  glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT24, width, height);
+  glBindFramebuffer(GL_FRAMEBUFFER, fbo_);
+  glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, renderbuffers_[0]);
+  glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, renderbuffers_[1]);
+  if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
+    throw GlUnavailable("the driver cannot make a colour + depth framebuffer for OpenSceneGraph");
+  viewer_ = new osgViewer::Viewer;
+  viewer_->setUseConfigureAffinity(false);  // OSG would pin this thread to one core (REFERENCE.md)
+  viewer_->setThreadingModel(model);
+  window_ = new EglWindow(*context_, width, height);
+  window_->setDefaultFboId(fbo_);
+  ::osg::Camera* camera = viewer_->getCamera();
+  camera->setGraphicsContext(window_.get());
+  camera->setViewport(new ::osg::Viewport(0, 0, width, height));
+  camera->setDrawBuffer(GL_COLOR_ATTACHMENT0);
+  camera->setReadBuffer(GL_COLOR_ATTACHMENT0);
+  camera->setComputeNearFarMode(::osg::CullSettings::DO_NOT_COMPUTE_NEAR_FAR);
+  camera->setClearColor({0.55f, 0.65f, 0.8f, 1.0f});
+}
+
+HeadlessViewer::~HeadlessViewer() {
+  set_scene(nullptr);
+  viewer_ = nullptr;
+  window_ = nullptr;
+  context_->make_current();
+  glDeleteFramebuffers(1, &fbo_);
+  glDeleteRenderbuffers(2, renderbuffers_);
+}
+
+void HeadlessViewer::set_scene(::osg::Node* scene) {
+  if (::osg::Node* old = viewer_->getSceneData(); old != nullptr && realized_) {
+    viewer_->stopThreading();  // a draw thread holds the context: it lets go
+    context_->make_current();
+    old->releaseGLObjects(window_->getState());  // a culling group hands back its queries here
+  }
+  viewer_->setSceneData(scene);
+  if (scene != nullptr && !realized_) {
+    require_supported_threading(*viewer_);  // heard here rather than from a draw thread
+    context_->release();                    // OSG makes it current where it draws
+    viewer_->realize();
+    realized_ = true;
+  }
+}
+
+double HeadlessViewer::frame(const View& view, double time_s) {
+  viewer_->getCamera()->setViewMatrix(to_osg(view.view));
+  viewer_->getCamera()->setProjectionMatrix(to_osg(view.proj));
+  const auto t0 = Clock::now();
+  viewer_->frame(time_s);  // closed by the window's swap: glFinish
+  return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+}
+
 const std::vector<std::string>& default_osg_rows() {
   static const std::vector<std::string> rows{"osg", "oqn", "oqn-strict", "vfc", "chcpp", "nohc", "grid"};
   return rows;
@@ -170,20 +225,19 @@ BenchResult run_osg_bench(const OsgBenchConfig& config, const ProgressFn& progre
   const auto say = [&](const std::string& line) {
     if (progress) progress(line, 0, 0, false);
   };
-  for (const std::string& row : rows)
-    if (!is_osg_row(row)) (void)session.make(row, config.options, say);  // checks the spec, calibrates nohc once
+  for (const std::string& row : rows) {
+    if (is_osg_row(row)) continue;
+    try {
+      (void)session.make(row, config.options, say);  // checks the spec; calibrates nohc once
+    } catch (const InputError& e) {
+      throw InputError(fmt::format("row {}: not osg, oqn or oqn-strict, nor an occull algorithm: {}", row, e.what()));
+    }
+  }
   const CullerContext context = session.culler_context(say);
 
   BenchResult result;
-  result.device = session.device();
+  describe_run(session, path, config.frames, result);
   result.scene = config.scene;
-  result.path = path.name();
-  result.objects = session.scene().objects().size();
-  result.triangles = session.scene().triangle_count();
-  result.bvh_nodes = session.bvh().size();
-  result.frames = config.frames;
-  result.sampling = config.sampling;
-  result.path_duration_s = path.duration();
   result.warmup = config.warmup;
   result.repeat = config.repeat;
   result.verified = config.verify;
@@ -202,27 +256,15 @@ BenchResult run_osg_bench(const OsgBenchConfig& config, const ProgressFn& progre
   }
   Scene& scene = session.scene();
 
-  std::unique_ptr<Device> retired;  // kept idle until the next row's (see Session::reset_renderer)
+  std::unique_ptr<HeadlessViewer> retired;  // kept idle until the next row's (see Session::reset_renderer)
   for (int rep = 0; rep < config.repeat; ++rep) {
     for (const std::string& row : rows) {
       const std::string label = config.repeat > 1 ? fmt::format("{} #{}", row, rep + 1) : row;
-      auto device = std::make_unique<Device>(config.width, config.height);
+      auto device = std::make_unique<HeadlessViewer>(config.width, config.height, model);
       std::vector<ObjectId> kept;
       RowGraph graph = make_row_graph(row, scene, config.options, context, kept);
-      ::osg::ref_ptr<osgViewer::Viewer> viewer = new osgViewer::Viewer;
-      viewer->setUseConfigureAffinity(false);  // OSG would pin this thread to one core (REFERENCE.md)
-      viewer->setThreadingModel(model);
-      ::osg::ref_ptr<osgViewer::GraphicsWindowEmbedded> window =
-          viewer->setUpViewerAsEmbeddedInWindow(0, 0, config.width, config.height);
-      window->setDefaultFboId(device->fbo);
-      ::osg::Camera* camera = viewer->getCamera();
-      camera->setDrawBuffer(GL_COLOR_ATTACHMENT0);
-      camera->setReadBuffer(GL_COLOR_ATTACHMENT0);
-      camera->setComputeNearFarMode(::osg::CullSettings::DO_NOT_COMPUTE_NEAR_FAR);
-      camera->setClearColor({0.55f, 0.65f, 0.8f, 1.0f});
-      viewer->setSceneData(graph.root);
-      if (graph.group) require_supported_threading(*viewer);
-      viewer->realize();
+      device->set_scene(graph.root.get());
+      const ::osg::Camera* camera = &device->camera();
 
       AlgorithmRun run;
       run.name = row;
@@ -238,14 +280,8 @@ BenchResult run_osg_bench(const OsgBenchConfig& config, const ProgressFn& progre
         const double t = session.frame_time(path, k, config.frames);
         scene.update(t);
         update_exported(scene, graph.exported);
-        const View view = session.view_at(path, k, config.frames);
-        camera->setViewMatrix(to_osg(view.view));
-        camera->setProjectionMatrix(to_osg(view.proj));
         kept.clear();
-        const auto t0 = Clock::now();
-        viewer->frame(t);
-        glFinish();
-        const double frame_ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+        const double frame_ms = device->frame(session.view_at(path, k, config.frames), t);
         if (progress) progress(label, warm ? step : step - config.warmup, warm ? config.warmup : config.frames, warm);
         if (warm) continue;
         FrameStats stats;
@@ -276,12 +312,7 @@ BenchResult run_osg_bench(const OsgBenchConfig& config, const ProgressFn& progre
         run.frames.push_back(stats);
       }
       run.longest_miss_frames = misses.longest();
-      // Queries handed back and GL objects freed while the row's context is current.
-      device->context->make_current();
-      if (graph.group) graph.group->releaseGLObjects(window->getState());
-      graph.root->releaseGLObjects(window->getState());
-      viewer = nullptr;
-      window = nullptr;
+      device->set_scene(nullptr);  // the group hands back its queries, the graph its GL objects
       result.runs.push_back(std::move(run));
       retired = std::move(device);
     }

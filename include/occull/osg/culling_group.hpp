@@ -70,6 +70,14 @@ class UnsupportedThreading : public occull::InputError {
   using occull::InputError::InputError;
 };
 
+/// A node the group cannot cull below: an osg::Camera or osg::Projection
+/// (they draw their subgraph with a view of their own). The cull traversal
+/// that meets one throws it, naming the node and its path.
+class UnsupportedNode : public occull::InputError {
+ public:
+  using occull::InputError::InputError;
+};
+
 /// Throws UnsupportedThreading, naming the model and the supported ones,
 /// when `viewer` runs (or, for AutomaticSelection, would choose) a threading
 /// model other than SingleThreaded or CullDrawThreadPerContext.

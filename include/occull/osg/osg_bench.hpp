@@ -4,11 +4,50 @@
 #pragma once
 
 #include "occull/bench.hpp"
+#include "occull/gl/context.hpp"
+
+#include <osgViewer/Viewer>
+
+#include <memory>
 
 #include <string>
 #include <vector>
 
 namespace osgOccull {
+
+/// A headless osgViewer::Viewer: a compatibility-profile EGL context of its
+/// own (Debian's OSG draws with the fixed-function pipeline) as the window's
+/// graphics context, made current by OSG on the thread that draws (the
+/// creating thread when SingleThreaded, OSG's draw thread otherwise), and a
+/// width x height colour + depth FBO the viewer draws into. OSG computes no
+/// near and far planes: the camera uses the view's projection as given.
+class HeadlessViewer {
+ public:
+  /// Throws occull::GlUnavailable without a usable OpenGL 4.5 compatibility
+  /// context, UnsupportedThreading (at the first set_scene) for a threading
+  /// model OcclusionCullingGroup refuses.
+  HeadlessViewer(int width, int height,
+                 osgViewer::ViewerBase::ThreadingModel model = osgViewer::ViewerBase::SingleThreaded);
+  ~HeadlessViewer();
+  HeadlessViewer(const HeadlessViewer&) = delete;
+  HeadlessViewer& operator=(const HeadlessViewer&) = delete;
+  /// Shows `scene` (null: nothing). The scene shown before releases its GL
+  /// objects on this context first (a culling group hands back its queries).
+  void set_scene(::osg::Node* scene);
+  /// One frame of `view` (its view and projection matrices) at `time_s`
+  /// seconds: viewer.frame(), closed by glFinish. Returns its wall time, ms.
+  double frame(const occull::View& view, double time_s);
+  [[nodiscard]] osgViewer::Viewer& viewer() noexcept { return *viewer_; }
+  [[nodiscard]] ::osg::Camera& camera() noexcept { return *viewer_->getCamera(); }
+
+ private:
+  std::unique_ptr<occull::gl::Context> context_;
+  GLuint fbo_ = 0;
+  GLuint renderbuffers_[2] = {0, 0};  // colour, depth
+  ::osg::ref_ptr<osgViewer::Viewer> viewer_;
+  ::osg::ref_ptr<::osg::GraphicsContext> window_;
+  bool realized_ = false;
+};
 
 /// The rows `occull osg` runs when none are named: OSG without occlusion
 /// culling, OcclusionQueryNode with its defaults and strict, occull's vfc,
