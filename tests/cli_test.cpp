@@ -742,3 +742,27 @@ TEST(Viewer, RefusesAViewItsAlgorithmHasNot) {
   EXPECT_EQ(r.code, 2) << r.output;
   EXPECT_NE(r.output.find("cells: grid"), std::string::npos) << r.output;
 }
+
+#ifdef OCCULL_OSG
+TEST(Cli, OsgRunsOsgsRowsBesideOccullsAndRefusesAnUnknownRowOrAnUnwritableExport) {
+  const CliRun help = run("osg --help");
+  EXPECT_EQ(help.code, 0);
+  for (const char* o : {"--rows", "--threading", "--export", "oqn-strict", "--scene", "--frames", "--json", "--report"})
+    EXPECT_NE(help.output.find(o), std::string::npos) << "osg help lacks " << o;
+  const CliRun r = run(std::string("osg ") + kTinyCity + " --rows osg,oqn,chcpp --frames 3 --warmup 1 --size 96x54");
+  EXPECT_EQ(r.code, 0) << r.output;
+  for (const char* name : {"osg", "oqn", "chcpp"}) EXPECT_FALSE(table_row(r.output, name).empty()) << name << r.output;
+  EXPECT_NE(r.output.find("inside OpenSceneGraph"), std::string::npos) << r.output;
+  const CliRun bad = run(std::string("osg ") + kTinyCity + " --rows osg,occlusionquery --frames 1");
+  EXPECT_EQ(bad.code, 2);
+  EXPECT_NE(bad.output.find("row occlusionquery: not osg, oqn or oqn-strict"), std::string::npos) << bad.output;
+  const CliRun unwritable = run(std::string("osg ") + kTinyCity + " --export /nonexistent/folder/city.osgb");
+  EXPECT_EQ(unwritable.code, 2);
+  EXPECT_NE(unwritable.output.find("/nonexistent/folder/city.osgb: OpenSceneGraph cannot write it"), std::string::npos)
+      << unwritable.output;
+  const CliRun threading = run(std::string("osg ") + kTinyCity + " --threading draw --frames 1");
+  EXPECT_EQ(threading.code, 2);
+  EXPECT_NE(threading.output.find("supports SingleThreaded and CullDrawThreadPerContext"), std::string::npos)
+      << threading.output;
+}
+#endif

@@ -892,7 +892,7 @@ constexpr std::pair<int, const char*> kExitCodes[] = {
     {1, "internal error (a bug: please report it with the message), including a violated run-time invariant of the instrument, with `--gl-debug` a failing OpenGL call, and a frame past the `--watchdog` time"},
     {2, "bad input: unknown scene / path / algorithm / option (the message lists the valid ones), invalid number or size, a damaged level, model, path or profile file (the message names the file and the fault), an output file or folder that cannot be written"},
     {3, "no usable OpenGL 4.5: EGL or the driver is missing (the message says which package); `view`: no display, or built without its viewer"},
-    {4, "`bench`: verification failed — a conservative algorithm culled a visible object (the table, JSON and report are written first)"},
+    {4, "`bench`, `osg`: verification failed — a conservative algorithm culled a visible object (the table, JSON and report are written first)"},
     {5, "`soak`: resident memory or the query pool grew more than 5 % from the first window to the last (the table and JSON are written first)"},
 };
 
