@@ -749,7 +749,7 @@ TEST(Cli, OsgRunsOsgsRowsBesideOccullsAndRefusesAnUnknownRowOrAnUnwritableExport
   EXPECT_EQ(help.code, 0);
   for (const char* o : {"--rows", "--threading", "--export", "oqn-strict", "--scene", "--frames", "--json", "--report"})
     EXPECT_NE(help.output.find(o), std::string::npos) << "osg help lacks " << o;
-  const CliRun r = run(std::string("osg ") + kTinyCity + " --rows osg,oqn,chcpp --frames 3 --warmup 1 --size 96x54");
+  const CliRun r = run(std::string("osg ") + kTinyCity + " --rows osg,oqn,chcpp --frames 3 --warmup 1");
   EXPECT_EQ(r.code, 0) << r.output;
   for (const char* name : {"osg", "oqn", "chcpp"}) EXPECT_FALSE(table_row(r.output, name).empty()) << name << r.output;
   EXPECT_NE(r.output.find("inside OpenSceneGraph"), std::string::npos) << r.output;

@@ -364,6 +364,26 @@ occull::BenchConfig bench_config(const BenchArgs& a) {
   return c;
 }
 
+// Writes a bench's JSON and CSV (to the streams given, opened before the run)
+// and its report folder (when `report` is not empty).
+void write_outputs(const occull::BenchResult& result, std::ofstream* json, const std::string& json_path,
+                   std::ofstream* csv, const std::string& csv_path, const std::string& report) {
+  if (json) {
+    occull::write_json(result, *json);
+    json->flush();
+    check_written(*json, json_path);
+  }
+  if (csv) {
+    occull::write_csv(result, *csv);
+    csv->flush();
+    check_written(*csv, csv_path);
+  }
+  if (!report.empty()) {
+    const auto files = occull::write_report(result, report);
+    std::fprintf(stderr, "report: %s/report.md (%zu files)\n", report.c_str(), files.size());
+  }
+}
+
 int cmd_bench(const BenchArgs& a) {
   const occull::BenchConfig c = bench_config(a);
   const bool report = !a.no_report && !a.report.empty();
@@ -375,20 +395,7 @@ int cmd_bench(const BenchArgs& a) {
   const auto result = occull::run_bench(c, std::ref(progress));
   occull::print_table(result, std::cout);
   std::cout.flush();
-  if (json) {
-    occull::write_json(result, *json);
-    json->flush();
-    check_written(*json, a.json);
-  }
-  if (csv) {
-    occull::write_csv(result, *csv);
-    csv->flush();
-    check_written(*csv, a.csv);
-  }
-  if (report) {
-    const auto files = occull::write_report(result, a.report);
-    std::fprintf(stderr, "report: %s/report.md (%zu files)\n", a.report.c_str(), files.size());
-  }
+  write_outputs(result, json.get(), a.json, csv.get(), a.csv, report ? a.report : std::string());
   // A conservative culler that misses a visible object is broken, whatever its frame time.
   return occull::verification_failures(result).empty() ? 0 : kExitVerificationFailed;
 }
@@ -435,15 +442,7 @@ int cmd_osg(const OsgArgs& a) {
   const auto result = osgOccull::run_osg_bench(c, std::ref(progress));
   occull::print_table(result, std::cout);
   std::cout.flush();
-  if (json) {
-    occull::write_json(result, *json);
-    json->flush();
-    check_written(*json, r.json);
-  }
-  if (report) {
-    const auto files = occull::write_report(result, r.report);
-    std::fprintf(stderr, "report: %s/report.md (%zu files)\n", r.report.c_str(), files.size());
-  }
+  write_outputs(result, json.get(), r.json, nullptr, "", report ? r.report : std::string());
   return occull::verification_failures(result).empty() ? 0 : kExitVerificationFailed;
 }
 #endif

@@ -184,20 +184,19 @@ class OcclusionCullingGroup::Drawer : public ::osg::Drawable {
 };
 
 OcclusionCullingGroup::OcclusionCullingGroup(std::string algorithm, Options options, CullerContext context)
-    : context_(std::move(context)), state_(std::make_shared<State>()) {
+    : context_(std::move(context)) {
   set_algorithm(std::move(algorithm), std::move(options));
-  state_->opaque = state_->scene.add_material({"opaque"});
-  Material glass{"translucent"};
-  glass.translucent = true;
-  state_->translucent = state_->scene.add_material(glass);
-  drawer_geode_ = new ::osg::Geode;
-  drawer_geode_->addDrawable(new Drawer(this));
-  drawer_geode_->setCullingActive(false);
+  start();
 }
 
+// A copy culls the same subgraph with its own scene and cullers.
 OcclusionCullingGroup::OcclusionCullingGroup(const OcclusionCullingGroup& g, const ::osg::CopyOp& op)
-    : ::osg::Group(g, op), algorithm_(g.algorithm_), options_(g.options_), context_(g.context_),
-      state_(std::make_shared<State>()) {
+    : ::osg::Group(g, op), algorithm_(g.algorithm_), options_(g.options_), context_(g.context_) {
+  start();
+}
+
+void OcclusionCullingGroup::start() {
+  state_ = std::make_shared<State>();
   state_->opaque = state_->scene.add_material({"opaque"});
   Material glass{"translucent"};
   glass.translucent = true;

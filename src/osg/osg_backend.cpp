@@ -193,10 +193,9 @@ void OsgBackend::check(QueryId q) const {
     throw std::logic_error(fmt::format("OcclusionCullingGroup: query {} is not in flight", q));
 }
 
-bool OsgBackend::result_available(QueryId q) {
-  Timed timed(stats_);
+bool OsgBackend::poll(QueryId q) {
   check(q);
-  if (!submitted_) {
+  if (!submitted_) {  // the driver submits the queries issued so far to answer
     ++stats_.flushes;
     submitted_ = true;
   }
@@ -205,17 +204,15 @@ bool OsgBackend::result_available(QueryId q) {
   return available == GL_TRUE;
 }
 
+bool OsgBackend::result_available(QueryId q) {
+  Timed timed(stats_);
+  return poll(q);
+}
+
 std::uint64_t OsgBackend::result(QueryId q) {
   Timed timed(stats_);
-  check(q);
-  if (!submitted_) {
-    ++stats_.flushes;
-    submitted_ = true;
-  }
-  GLuint available = GL_FALSE;
-  gl_->glGetQueryObjectuiv(names_[q], GL_QUERY_RESULT_AVAILABLE, &available);
   GLuint64 samples = 0;
-  if (available == GL_TRUE) {
+  if (poll(q)) {
     gl_->glGetQueryObjectui64v(names_[q], GL_QUERY_RESULT, &samples);
   } else {
     ++stats_.blocking_waits;

@@ -68,6 +68,7 @@ class OsgBackend final : public occull::Backend {
   void enter(Mode mode);
   void draw_object(occull::ObjectId id);
   void check(occull::QueryId q) const;
+  bool poll(occull::QueryId q);  // whether q's result is there, counting the submission a first poll makes
 };
 
 }  // namespace osgOccull::detail

@@ -142,6 +142,7 @@ class OcclusionCullingGroup : public ::osg::Group {
   std::shared_ptr<State> state_;
   ::osg::ref_ptr<::osg::Geode> drawer_geode_;
   std::mutex mutex_;  // gathering and per-camera state: cull and draw threads of several contexts
+  void start();  // an empty scene, no cullers yet, the group's drawable
   void gather(unsigned frame_number);
   void draw(::osg::RenderInfo& info);
 };
