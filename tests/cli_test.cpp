@@ -765,4 +765,25 @@ TEST(Cli, OsgRunsOsgsRowsBesideOccullsAndRefusesAnUnknownRowOrAnUnwritableExport
   EXPECT_NE(threading.output.find("supports SingleThreaded and CullDrawThreadPerContext"), std::string::npos)
       << threading.output;
 }
+
+TEST(Cli, OsgFlysAFileOsgReadsVerifiedAndRefusesOneItCannotRead) {
+  const std::string file = ::testing::TempDir() + "occull_cli_city.osgt";
+  const CliRun exported = run(std::string("osg ") + kTinyCity + " --export " + file);
+  ASSERT_EQ(exported.code, 0) << exported.output;
+  const CliRun r = run("osg --file " + file + " --rows osg,vfc,chcpp --frames 4 --warmup 1 --size 64x48");
+  EXPECT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("path orbit"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("verification passed"), std::string::npos) << r.output;
+  const std::vector<std::string> chcpp = table_row(r.output, "chcpp");
+  ASSERT_GT(chcpp.size(), std::size_t(kMissed)) << r.output;
+  EXPECT_EQ(chcpp[kMissed], "0") << r.output;
+  const CliRun missing = run("osg --file /nonexistent/model.osgb --frames 1");
+  EXPECT_EQ(missing.code, 2);
+  EXPECT_NE(missing.output.find("/nonexistent/model.osgb: no such file"), std::string::npos) << missing.output;
+  const std::string damaged = ::testing::TempDir() + "occull_cli_damaged.osgt";
+  std::ofstream(damaged) << "#Ascii Scene\n#Version 161\nosg::Group {\n  UniqueID 1\n  Children 7 {\n";
+  const CliRun bad = run("osg --file " + damaged + " --frames 1");
+  EXPECT_EQ(bad.code, 2);
+  EXPECT_NE(bad.output.find(damaged + ": "), std::string::npos) << bad.output;
+}
 #endif

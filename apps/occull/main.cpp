@@ -406,6 +406,7 @@ struct OsgArgs {
   std::string rows;
   std::string threading = "single";
   std::string export_file;
+  std::string file;
 };
 
 // `osg`: occull's cullers inside OpenSceneGraph beside OSG's OcclusionQueryNode.
@@ -423,6 +424,7 @@ int cmd_osg(const OsgArgs& a) {
   }
   osgOccull::OsgBenchConfig c;
   c.scene = r.scene;
+  c.file = a.file;
   c.path = r.path;
   c.rows = split_list(a.rows);
   c.frames = r.frames;
@@ -970,6 +972,9 @@ int main(int argc, char** argv) {
                  "the models that draw while the next frame is culled are refused")
       ->capture_default_str();
   og->add_option("--report", osg_args.run.report, "write report.md, SVG charts, JSON and CSV into this folder");
+  og->add_option("--file", osg_args.file,
+                 "instead of --scene: a file OSG reads (.osgt, .osgb, .ive, .obj, .3ds, .flt, ...), flown on its path "
+                 "orbit or through (--path), verified against the ground truth of its triangles");
   og->add_option("--export", osg_args.export_file,
                  "write the scene as an OSG file (.osgt, .osgb, .ive, ...: any format OSG writes) and exit");
 #endif

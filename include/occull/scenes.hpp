@@ -59,4 +59,10 @@ struct SceneBundle {
 /// out of range.
 [[nodiscard]] SceneBundle make_scene(std::string_view spec);
 
+/// A model's lens and camera paths, from its scene's bounds: `orbit`
+/// (circles it at 1.6 radii, looking at its centre) and `through` (flies
+/// straight through its middle); near and far planes scaled to its size.
+/// What `file:` scenes get, and models converted by their owner.
+void add_model_views(SceneBundle& bundle);
+
 }  // namespace occull

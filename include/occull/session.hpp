@@ -138,6 +138,10 @@ class Session {
   /// then creates the GL context (throws GlUnavailable) and the renderer.
   Session(std::string_view scene_spec, const gl::RendererOptions& renderer_options,
           const BvhOptions& bvh_options = {}, const gl::ContextOptions& context_options = {});
+  /// The same over a scene made elsewhere (a model converted by its
+  /// owner: `occull osg --file`), named `name` in messages and reports.
+  Session(std::string name, SceneBundle bundle, const gl::RendererOptions& renderer_options,
+          const BvhOptions& bvh_options = {}, const gl::ContextOptions& context_options = {});
   ~Session();
   Session(const Session&) = delete;
   Session& operator=(const Session&) = delete;
@@ -330,6 +334,7 @@ class Session {
   std::unique_ptr<RecordingBackend> recorder_;
   std::unique_ptr<StallGuard> guard_;
   void wrap_renderer();  // (re)builds recorder_ and guard_ over renderer_
+  void start(const gl::RendererOptions& renderer_options, const BvhOptions& bvh_options);  // BVH, context, renderer
   std::unique_ptr<LoggingBackend> logger_;  // over backend(), for logged frames; goes before both
   std::unique_ptr<detail::Watchdog> watchdog_;
   std::optional<HardwareProfile> profile_;

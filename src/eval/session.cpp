@@ -42,6 +42,16 @@ Session::Session(std::string_view scene_spec, const gl::RendererOptions& rendere
                  const BvhOptions& bvh_options, const gl::ContextOptions& context_options)
     : scene_spec_(scene_spec), bundle_(timed_make_scene(scene_spec, scene_build_ms_)),
       context_options_(context_options) {
+  start(renderer_options, bvh_options);
+}
+
+Session::Session(std::string name, SceneBundle bundle, const gl::RendererOptions& renderer_options,
+                 const BvhOptions& bvh_options, const gl::ContextOptions& context_options)
+    : scene_spec_(std::move(name)), bundle_(std::move(bundle)), context_options_(context_options) {
+  start(renderer_options, bvh_options);
+}
+
+void Session::start(const gl::RendererOptions& renderer_options, const BvhOptions& bvh_options) {
   const auto t0 = Clock::now();
   // A tiled world has no global hierarchy: its cullers keep one BVH
   // instance per tile (occull/tiles.hpp).
@@ -51,7 +61,7 @@ Session::Session(std::string_view scene_spec, const gl::RendererOptions& rendere
   if (bundle_.world && float(renderer_options.width) > TiledWorld::kMaxAspect * float(renderer_options.height))
     throw InputError(fmt::format("{}: a {}x{} viewport is wider than {}:1, the widest a tiled world's window of "
                                  "placed tiles covers (occull::TiledWorld::kMaxAspect)",
-                                 scene_spec, renderer_options.width, renderer_options.height,
+                                 scene_spec_, renderer_options.width, renderer_options.height,
                                  TiledWorld::kMaxAspect));
   context_ = gl::Context::create(context_options_);
   device_ = context_->info();

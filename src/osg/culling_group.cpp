@@ -4,6 +4,7 @@
 
 #include "occull/bvh.hpp"
 #include "occull/view.hpp"
+#include "gatherer.hpp"
 #include "osg_backend.hpp"
 
 #include <osg/BlendFunc>
@@ -19,11 +20,16 @@
 #include <glm/gtc/type_ptr.hpp>
 
 #include <chrono>
+#include <utility>
 #include <map>
 #include <unordered_map>
 
 namespace osgOccull {
 using namespace occull;
+using detail::Gatherer;
+using detail::TriangleCount;
+using detail::is_translucent;
+using detail::occluder_of;
 namespace {
 
 using Clock = std::chrono::steady_clock;
@@ -41,91 +47,6 @@ const char* threading_name(osgViewer::ViewerBase::ThreadingModel m) {
 }
 
 glm::mat4 to_glm(const ::osg::Matrix& m) { return glm::make_mat4(::osg::Matrixf(m).ptr()); }
-
-// Triangles and their area, for a drawable's MeshInfo.
-struct TriangleCount {
-  std::uint32_t triangles = 0;
-  double area = 0.0;
-  void operator()(const ::osg::Vec3& a, const ::osg::Vec3& b, const ::osg::Vec3& c) {
-    ++triangles;
-    area += 0.5 * double(((b - a) ^ (c - a)).length());
-  }
-};
-
-bool is_translucent(const ::osg::StateSet* s) {
-  return s != nullptr && (s->getRenderingHint() == ::osg::StateSet::TRANSPARENT_BIN ||
-                          (s->getMode(GL_BLEND) & ::osg::StateAttribute::ON) != 0);
-}
-
-// "occull.occluder" on a node of the path: always | sometimes | never.
-OccluderClass occluder_of(const ::osg::NodePath& path, bool translucent) {
-  if (translucent) return OccluderClass::never;
-  for (auto it = path.rbegin(); it != path.rend(); ++it) {
-    std::string value;
-    if ((*it)->getUserValue("occull.occluder", value)) {
-      if (value == "always") return OccluderClass::always;
-      if (value == "never") return OccluderClass::never;
-      return OccluderClass::sometimes;
-    }
-  }
-  return OccluderClass::sometimes;
-}
-
-// Walks a subgraph: every drawable reached through active children, with
-// its path, its transform to the walk's start and the state sets above it.
-class Gatherer : public ::osg::NodeVisitor {
- public:
-  struct Found {
-    ::osg::Drawable* drawable;
-    ::osg::NodePath path;
-    ::osg::Matrix to_group;
-    std::vector<const ::osg::StateSet*> states;
-  };
-  std::vector<Found> found;
-
-  Gatherer() : ::osg::NodeVisitor(TRAVERSE_ACTIVE_CHILDREN) {}
-  void apply(::osg::Node& node) override {
-    push(node);
-    traverse(node);
-    pop(node);
-  }
-  void apply(::osg::Transform& t) override {
-    push(t);
-    const ::osg::Matrix saved = matrix_;
-    t.computeLocalToWorldMatrix(matrix_, this);
-    traverse(t);
-    matrix_ = saved;
-    pop(t);
-  }
-  // A camera (render to texture, a HUD) or a projection draws its subgraph
-  // with a view of its own, which a culler of this group's view cannot judge.
-  void apply(::osg::Camera& c) override { refuse(c, "osg::Camera"); }
-  void apply(::osg::Projection& p) override { refuse(p, "osg::Projection"); }
-  void apply(::osg::Drawable& d) override {
-    push(d);
-    found.push_back({&d, getNodePath(), matrix_, states_});
-    pop(d);
-  }
-
- private:
-  ::osg::Matrix matrix_;
-  std::vector<const ::osg::StateSet*> states_;
-  [[noreturn]] void refuse(::osg::Node& n, const char* kind) {
-    std::string where;
-    for (const ::osg::Node* p : getNodePath())
-      where += fmt::format("{}{}", where.empty() ? "" : " > ", p->getName().empty() ? p->className() : p->getName());
-    throw UnsupportedNode(fmt::format(
-        "OcclusionCullingGroup: cannot cull below a {} ('{}', at {}): it draws its subgraph with a view of its own; "
-        "put it outside the group",
-        kind, n.getName(), where));
-  }
-  void push(::osg::Node& n) {
-    if (n.getStateSet() != nullptr) states_.push_back(n.getStateSet());
-  }
-  void pop(::osg::Node& n) {
-    if (n.getStateSet() != nullptr) states_.pop_back();
-  }
-};
 
 }  // namespace
 
@@ -154,11 +75,25 @@ struct OcclusionCullingGroup::State {
   bool built = false;
   MaterialId opaque = 0, translucent = 0;
   unsigned gathered_frame = ~0u;
-  std::map<::osg::NodePath, ObjectId> ids;                   // instance path -> object
+  std::unordered_map<std::uint64_t, ObjectId> ids;            // instance path's key -> object
   std::unordered_map<const ::osg::Drawable*, MeshId> meshes;  // shared geometry: one mesh per drawable
-  std::map<std::vector<const ::osg::StateSet*>, ::osg::ref_ptr<::osg::StateSet>> merged;
+  std::unordered_map<std::uint64_t, ::osg::ref_ptr<::osg::StateSet>> merged;  // state-set list's key -> merged
+  std::vector<std::uint64_t> state_keys;                      // per object: its list's key
+  std::vector<std::uint64_t> seen;                            // per object: the last walk that met it
+  std::uint64_t walk = 0;
+  // The state sets of a path merged into one (null for none), one per list.
+  ::osg::ref_ptr<::osg::StateSet> merged_state(std::span<const ::osg::StateSet* const> states, std::uint64_t key) {
+    if (states.empty()) return nullptr;
+    auto [it, added] = merged.try_emplace(key);
+    if (added) {
+      it->second = new ::osg::StateSet;
+      for (const ::osg::StateSet* ss : states) it->second->merge(*ss);
+    }
+    return it->second;
+  }
   std::map<const ::osg::Camera*, CameraCuller> cameras;
   bool warned_view = false;
+  double gather_ms = 0.0;  // the last gather's wall time
 };
 
 class OcclusionCullingGroup::Drawer : public ::osg::Drawable {
@@ -246,58 +181,58 @@ void OcclusionCullingGroup::gather(unsigned frame_number) {
   State& s = *state_;
   if (s.built && s.gathered_frame == frame_number) return;  // another camera's cull gathered this frame
   s.gathered_frame = frame_number;
-  Gatherer g;
-  for (unsigned i = 0; i < getNumChildren(); ++i) getChild(i)->accept(g);
-
-  instances_.resize(s.scene.objects().size());
-  std::vector<bool> seen(s.scene.objects().size(), false);
-  for (Gatherer::Found& f : g.found) {
-    // The merged state of the path (one StateSet per distinct list).
-    ::osg::ref_ptr<::osg::StateSet> merged;
-    if (!f.states.empty()) {
-      auto [it, added] = s.merged.try_emplace(f.states);
-      if (added) {
-        it->second = new ::osg::StateSet;
-        for (const ::osg::StateSet* ss : f.states) it->second->merge(*ss);
-      }
-      merged = it->second;
-    }
-    const glm::mat4 transform = to_glm(f.to_group);
-    if (const auto it = s.ids.find(f.path); it != s.ids.end()) {
+  const auto t0 = Clock::now();
+  ++s.walk;
+  auto found = [&](::osg::Drawable& drawable, const ::osg::NodePath& path, std::uint64_t path_key,
+                   const ::osg::Matrix& to_group, std::span<const ::osg::StateSet* const> states,
+                   std::uint64_t state_key) {
+    // Known instance: the same path (a colliding key probes on).
+    auto it = s.ids.find(path_key);
+    while (it != s.ids.end() && instances_[it->second].path != path) it = s.ids.find(++path_key);
+    if (it != s.ids.end()) {
       const ObjectId id = it->second;
-      seen[id] = true;
+      s.seen[id] = s.walk;
       Instance& inst = instances_[id];
-      if (!(inst.to_group == f.to_group)) {
-        s.scene.set_transform(id, transform);
-        inst.to_group = f.to_group;
+      if (!(inst.to_group == to_group)) {
+        s.scene.set_transform(id, to_glm(to_group));
+        inst.to_group = to_group;
       }
-      inst.state = merged;
-      continue;
+      if (s.state_keys[id] != state_key) {
+        s.state_keys[id] = state_key;
+        inst.state = s.merged_state(states, state_key);
+        // (a change of translucency keeps the object's class: it is re-added when it moves in the graph)
+      }
+      return;
     }
-    auto [mesh_it, new_mesh] = s.meshes.try_emplace(f.drawable, 0);
+    auto [mesh_it, new_mesh] = s.meshes.try_emplace(&drawable, 0);
     if (new_mesh) {
       ::osg::TriangleFunctor<TriangleCount> count;
-      f.drawable->accept(count);
-      const ::osg::BoundingBox& b = f.drawable->getBoundingBox();
+      drawable.accept(count);
+      const ::osg::BoundingBox& b = drawable.getBoundingBox();
       MeshInfo info;
       if (b.valid()) info.bounds = Aabb{{b.xMin(), b.yMin(), b.zMin()}, {b.xMax(), b.yMax(), b.zMax()}};
       info.triangles = count.triangles;
       info.surface_area = count.area;
       mesh_it->second = s.scene.add_mesh(info);
     }
+    ::osg::ref_ptr<::osg::StateSet> merged = s.merged_state(states, state_key);
     const bool translucent = is_translucent(merged.get());
-    const ObjectId id = s.scene.add_object(mesh_it->second, translucent ? s.translucent : s.opaque, transform,
-                                           occluder_of(f.path, translucent));
-    s.ids.emplace(f.path, id);
+    const ObjectId id = s.scene.add_object(mesh_it->second, translucent ? s.translucent : s.opaque,
+                                           to_glm(to_group), occluder_of(path, translucent));
+    s.ids.emplace(path_key, id);
     if (id >= instances_.size()) {
       instances_.resize(id + 1);
-      seen.resize(id + 1, false);
+      s.seen.resize(id + 1, 0);
+      s.state_keys.resize(id + 1, 0);
     }
-    seen[id] = true;
-    instances_[id] = Instance{f.drawable, f.path, f.to_group, merged, translucent};
-  }
-  for (auto it = s.ids.begin(); it != s.ids.end();) {
-    if (seen[it->second]) {
+    s.seen[id] = s.walk;
+    s.state_keys[id] = state_key;
+    instances_[id] = Instance{&drawable, path, to_group, merged, translucent};
+  };
+  Gatherer<decltype(found)> g(found);
+  for (unsigned i = 0; i < getNumChildren(); ++i) getChild(i)->accept(g);
+  for (auto it = s.ids.begin(); it != s.ids.end();) {  // what the walk did not meet is gone
+    if (s.seen[it->second] == s.walk) {
       ++it;
       continue;
     }
@@ -314,6 +249,7 @@ void OcclusionCullingGroup::gather(unsigned frame_number) {
   s.scene.clear_moved();
   drawer_geode_->getDrawable(0)->dirtyBound();
   drawer_geode_->dirtyBound();
+  s.gather_ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
 }
 
 void OcclusionCullingGroup::draw(::osg::RenderInfo& info) {
@@ -331,6 +267,7 @@ void OcclusionCullingGroup::draw(::osg::RenderInfo& info) {
   const ::osg::Viewport* vp = state.getCurrentViewport();
   if (vp == nullptr && camera != nullptr) vp = camera->getViewport();
   c.frame = {};
+  c.frame.gather_ms = std::exchange(s.gather_ms, 0.0);  // the first camera drawn after a gather pays for it
   c.backend->begin_frame(info, view_matrix, instances_, s.scene);
   const BackendStats before = c.backend->stats();
   std::optional<View> view;

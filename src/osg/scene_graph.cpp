@@ -2,15 +2,21 @@
 #include "occull/osg/scene_graph.hpp"
 
 #include "occull/error.hpp"
+#include "gatherer.hpp"
 
 #include <osg/BlendFunc>
 #include <osg/Depth>
 #include <osg/Geode>
 #include <osg/Geometry>
 #include <osg/Material>
+#include <osg/TriangleFunctor>
 
 #include <fmt/format.h>
 #include <glm/gtc/type_ptr.hpp>
+
+#include <map>
+#include <tuple>
+#include <unordered_map>
 
 namespace osgOccull {
 using namespace occull;
@@ -99,6 +105,92 @@ ExportedScene export_scene(const Scene& scene) {
 void update_exported(const Scene& scene, ExportedScene& exported) {
   for (ObjectId id : scene.dynamic_objects())
     if (id < exported.objects.size() && exported.objects[id]) exported.objects[id]->setMatrix(to_osg(scene.object(id).transform));
+}
+
+namespace {
+
+// A drawable's triangles in its own coordinates, flat-shaded.
+struct TriangleCopy {
+  Mesh* mesh = nullptr;
+  void operator()(const ::osg::Vec3& a, const ::osg::Vec3& b, const ::osg::Vec3& c) {
+    const ::osg::Vec3 n0 = (b - a) ^ (c - a);
+    const float length = n0.length();
+    const ::osg::Vec3 n = length > 0.0f ? n0 / length : ::osg::Vec3(0, 1, 0);
+    for (const ::osg::Vec3* v : {&a, &b, &c}) {
+      mesh->indices.push_back(std::uint32_t(mesh->positions.size()));
+      mesh->positions.push_back({v->x(), v->y(), v->z()});
+      mesh->normals.push_back({n.x(), n.y(), n.z()});
+    }
+  }
+};
+
+glm::vec4 diffuse_of(const ::osg::StateSet* s) {
+  if (s != nullptr)
+    if (const auto* m = dynamic_cast<const ::osg::Material*>(s->getAttribute(::osg::StateAttribute::MATERIAL))) {
+      const ::osg::Vec4 d = m->getDiffuse(::osg::Material::FRONT);
+      return {d.r(), d.g(), d.b(), d.a()};
+    }
+  return {0.8f, 0.8f, 0.8f, 1.0f};
+}
+
+}  // namespace
+
+ImportedGraph import_graph(::osg::Node& root, const std::string& name) {
+  ImportedGraph out{SceneBundle{Scene(name), {}, Lens{}}, {}, &root};
+  Scene& scene = out.bundle.scene;
+  std::unordered_map<const ::osg::Drawable*, MeshId> meshes;
+  std::unordered_map<std::uint64_t, ::osg::ref_ptr<::osg::StateSet>> merged;
+  std::map<std::tuple<float, float, float, float, bool>, MaterialId> materials;
+  auto found = [&](::osg::Drawable& drawable, const ::osg::NodePath& path, std::uint64_t, const ::osg::Matrix& to_root,
+                   std::span<const ::osg::StateSet* const> states, std::uint64_t state_key) {
+    auto [mesh_it, new_mesh] = meshes.try_emplace(&drawable, 0);
+    if (new_mesh) {
+      Mesh mesh;
+      ::osg::TriangleFunctor<TriangleCopy> copy;
+      copy.mesh = &mesh;
+      drawable.accept(copy);
+      mesh_it->second = scene.add_mesh(std::move(mesh));
+    }
+    ::osg::ref_ptr<::osg::StateSet> state;
+    if (!states.empty()) {
+      auto [it, added] = merged.try_emplace(state_key);
+      if (added) {
+        it->second = new ::osg::StateSet;
+        for (const ::osg::StateSet* ss : states) it->second->merge(*ss);
+      }
+      state = it->second;
+    }
+    const bool translucent = detail::is_translucent(state.get());
+    const glm::vec4 colour = diffuse_of(state.get());
+    auto [m, new_material] = materials.try_emplace({colour.r, colour.g, colour.b, colour.a, translucent}, 0);
+    if (new_material) m->second = scene.add_material({"", colour, translucent, 0});
+    scene.add_object(mesh_it->second, m->second, glm::make_mat4(::osg::Matrixf(to_root).ptr()),
+                     detail::occluder_of(path, translucent));
+    out.instances.push_back(Instance{&drawable, path, to_root, state, translucent});
+  };
+  detail::Gatherer<decltype(found)> walk(found);
+  root.accept(walk);
+  if (scene.triangle_count() == 0) throw InputError(fmt::format("{}: has no triangles OpenSceneGraph can draw", name));
+  add_model_views(out.bundle);
+  return out;
+}
+
+ExportedScene flatten(std::span<const Instance> instances) {
+  ExportedScene out;
+  out.root = new ::osg::Group;
+  for (std::size_t id = 0; id < instances.size(); ++id) {
+    const Instance& i = instances[id];
+    ::osg::ref_ptr<::osg::MatrixTransform> t = new ::osg::MatrixTransform(i.to_group);
+    t->setUserValue("occull.object", int(id));
+    t->setUserValue("occull.occluder", std::string(occluder_name(detail::occluder_of(i.path, i.translucent))));
+    if (i.state) t->setStateSet(i.state.get());
+    ::osg::ref_ptr<::osg::Geode> geode = new ::osg::Geode;
+    geode->addDrawable(i.drawable.get());
+    t->addChild(geode);
+    out.root->addChild(t);
+    out.objects.push_back(t);
+  }
+  return out;
 }
 
 std::int64_t exported_object(const ::osg::NodePath& path) {

@@ -314,7 +314,16 @@ SceneBundle load_model_file(const std::string& path, std::uint32_t object_triang
                      scene.material(m).translucent ? OccluderClass::never : OccluderClass::always);
   }
 
-  const Aabb box = scene.bounds();
+  add_model_views(bundle);
+  return bundle;
+}
+
+}  // namespace occull::scenes
+
+namespace occull {
+
+void add_model_views(SceneBundle& bundle) {
+  const Aabb box = bundle.scene.bounds();
   const glm::vec3 c = box.center();
   const float radius = std::max(0.5f * glm::length(box.extent()), 1e-3f);
   bundle.lens = Lens{60.0f, radius * 1e-3f, radius * 20.0f};
@@ -329,7 +338,6 @@ SceneBundle load_model_file(const std::string& path, std::uint32_t object_triang
   bundle.paths.emplace_back("through", "flies straight through the middle of the model",
                             std::vector<CameraPath::Key>{{0.0, {c + glm::vec3(0, 0, 1.5f * radius), 0.0f, 0.0f}, false},
                                                          {8.0, {c - glm::vec3(0, 0, 1.5f * radius), 0.0f, 0.0f}, false}});
-  return bundle;
 }
 
-}  // namespace occull::scenes
+}  // namespace occull

@@ -97,6 +97,9 @@ struct CameraFrame {
   std::vector<occull::ObjectId> drawn;  ///< objects drawn (ascending; ids of instances())
   occull::FrameStats culler;            ///< the culler's own counters; cpu_ms: its time outside backend calls, ms
   occull::BackendStats backend;         ///< what the backend counted in the frame (draws, queries, waits, ...)
+  /// Time the group spent gathering the graph into its scene this frame
+  /// (walk, changes, refit), ms; counted for the first camera drawn after it.
+  double gather_ms = 0.0;
 };
 
 class OcclusionCullingGroup : public ::osg::Group {

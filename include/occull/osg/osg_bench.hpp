@@ -59,6 +59,10 @@ class HeadlessViewer {
 
 struct OsgBenchConfig {
   std::string scene = "city";  ///< occull scene spec (exported to an OSG graph: export_scene)
+  /// Instead of `scene`: a file OSG's plugins read (.osgt, .osgb, .ive,
+  /// .obj, .3ds, .flt, ...), imported (import_graph) and flown on its
+  /// `orbit` or `through` path, each row over its flattened graph (flatten).
+  std::string file;
   std::string path;            ///< camera path; empty = the scene's first
   /// Rows: "osg" (OSG's frustum and small-feature culling only), "oqn"
   /// (an osg::OcclusionQueryNode over every object, OSG's defaults: 500
@@ -86,7 +90,8 @@ struct OsgBenchConfig {
 /// What a row drew in a frame is what reached OSG's draw: for OSG's rows the
 /// objects its cull traversal kept (a cull callback per object), for occull's
 /// the objects the group's culler drew. Throws occull::InputError for an
-/// unknown row, scene, path or threading model (listing the valid ones).
+/// unknown row, scene, path or threading model (listing the valid ones), a
+/// file that is missing, that OSG cannot read, or that has no triangles.
 [[nodiscard]] occull::BenchResult run_osg_bench(const OsgBenchConfig& config,
                                                 const occull::ProgressFn& progress = {});
 

@@ -1,13 +1,18 @@
-// An occull scene as an OpenSceneGraph graph: what `occull osg` flies, and
-// what `occull osg --export FILE` writes for OSG's own tools (osgviewer).
+// An occull scene as an OpenSceneGraph graph (what `occull osg` flies, and
+// what `occull osg --export FILE` writes for OSG's own tools, osgviewer),
+// and a graph read from a file as an occull scene (`occull osg --file`).
 #pragma once
 
+#include "occull/osg/culling_group.hpp"
 #include "occull/scene.hpp"
+#include "occull/scenes.hpp"
 
 #include <osg/Group>
 #include <osg/MatrixTransform>
 
 #include <cstdint>
+#include <span>
+#include <string>
 #include <vector>
 
 namespace osgOccull {
@@ -31,6 +36,30 @@ struct ExportedScene {
 /// Moves the exported objects to where `scene`'s objects are now (after
 /// occull::Scene::update moved the dynamic ones, or an engine's set_transform).
 void update_exported(const occull::Scene& scene, ExportedScene& exported);
+
+/// A graph read from a file (`occull osg --file`) as an occull scene.
+struct ImportedGraph {
+  /// One object per drawable instance, in the order a walk meets them, its
+  /// triangles copied (occull's renderer draws the ground truth from them);
+  /// materials from the instance's osg::Material diffuse colour; lens and
+  /// camera paths `orbit` and `through` (add_model_views).
+  occull::SceneBundle bundle;
+  /// Per object: the drawable as loaded, its transform to the graph's root,
+  /// the state sets of its path merged.
+  std::vector<Instance> instances;
+  ::osg::ref_ptr<::osg::Node> root;  ///< the graph, kept: the instances' paths point into it
+};
+
+/// Reads `root`'s drawable instances (active children, as
+/// OcclusionCullingGroup gathers them). Throws UnsupportedNode for a camera
+/// or projection in the graph, occull::InputError (naming `name`) for a
+/// graph without triangles.
+[[nodiscard]] ImportedGraph import_graph(::osg::Node& root, const std::string& name);
+
+/// The instances as a flat graph every row of `occull osg` can name its
+/// objects in: one MatrixTransform per instance ("occull.object" = its id,
+/// its merged state set) over its drawable as loaded (shared, not copied).
+[[nodiscard]] ExportedScene flatten(std::span<const Instance> instances);
 
 /// The "occull.object" id on the nearest node of `path` that carries one,
 /// or -1: which object of an exported scene a drawable instance is.
