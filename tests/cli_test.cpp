@@ -749,8 +749,14 @@ TEST(Cli, OsgRunsOsgsRowsBesideOccullsAndRefusesAnUnknownRowOrAnUnwritableExport
   EXPECT_EQ(help.code, 0);
   for (const char* o : {"--rows", "--threading", "--export", "oqn-strict", "--scene", "--frames", "--json", "--report"})
     EXPECT_NE(help.output.find(o), std::string::npos) << "osg help lacks " << o;
-  const CliRun r = run(std::string("osg ") + kTinyCity + " --rows osg,oqn,chcpp --frames 3 --warmup 1");
+  const std::string png = ::testing::TempDir() + "occull_cli_osg";
+  const CliRun r = run(std::string("osg ") + kTinyCity + " --rows osg,oqn,chcpp --frames 3 --warmup 1 --png " + png);
   EXPECT_EQ(r.code, 0) << r.output;
+  for (const char* name : {"osg", "oqn", "chcpp"}) {
+    const std::string file = png + "-" + name + ".png";
+    EXPECT_NE(r.output.find("wrote " + file), std::string::npos) << r.output;
+    EXPECT_GT(std::filesystem::exists(file) ? std::filesystem::file_size(file) : 0u, 100u) << file;
+  }
   for (const char* name : {"osg", "oqn", "chcpp"}) EXPECT_FALSE(table_row(r.output, name).empty()) << name << r.output;
   EXPECT_NE(r.output.find("inside OpenSceneGraph"), std::string::npos) << r.output;
   const CliRun bad = run(std::string("osg ") + kTinyCity + " --rows osg,occlusionquery --frames 1");

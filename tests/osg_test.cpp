@@ -81,6 +81,24 @@ TEST(OsgCullingGroup, ABoxBehindAWallIsNotDrawnAndAVisibleOneIs) {
   EXPECT_TRUE(drew(*s.group, v.camera(), hidden));
 }
 
+TEST(OsgCullingGroup, OsgsOwnFrustumAndSmallFeatureCullingDoNotChangeWhatTheGroupDraws) {
+  std::vector<occull::ObjectId> drawn[2];
+  for (int k = 0; k < 2; ++k) {
+    HeadlessViewer v(64, 64);
+    v.camera().setCullingMode(k == 0 ? osg::CullSettings::NO_CULLING
+                                     : osg::CullSettings::DEFAULT_CULLING | osg::CullSettings::SMALL_FEATURE_CULLING);
+    v.camera().setSmallFeatureCullingPixelSize(k == 0 ? 0.0f : 1000.0f);  // would cull every box we have
+    Walled s;
+    v.set_scene(s.group.get());
+    v.frame(camera_view(), 0.0);
+    ASSERT_NE(s.group->last_frame(&v.camera()), nullptr);
+    drawn[k] = s.group->last_frame(&v.camera())->drawn;
+    EXPECT_FALSE(drew(*s.group, v.camera(), object_of(*s.group, s.hidden->getDrawable(0))));
+  }
+  EXPECT_EQ(drawn[0], drawn[1]);
+  EXPECT_EQ(drawn[0].size(), 2u);  // the wall and the box in front of it
+}
+
 TEST(OsgCullingGroup, MovingATransformMovesTheObjectsBox) {
   HeadlessViewer v(64, 64);
   Walled s;

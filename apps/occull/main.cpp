@@ -407,6 +407,7 @@ struct OsgArgs {
   std::string threading = "single";
   std::string export_file;
   std::string file;
+  std::string png;
 };
 
 // `osg`: occull's cullers inside OpenSceneGraph beside OSG's OcclusionQueryNode.
@@ -437,6 +438,15 @@ int cmd_osg(const OsgArgs& a) {
   c.verify = parse_on_off("--verify", r.verify);
   c.threading = a.threading;
   c.options = parse_options(r.opts);
+  if (!a.png.empty())
+    c.last_frame = [&](const std::string& row, int width, int height, const std::vector<std::uint8_t>& rgba) {
+      std::string name = row;
+      std::replace_if(name.begin(), name.end(), [](char ch) { return ch == ':' || ch == '=' || ch == '/'; }, '_');
+      const std::string file = fmt::format("{}-{}.png", a.png, name);
+      if (!stbi_write_png(file.c_str(), width, height, 4, rgba.data(), width * 4))
+        throw occull::InputError(fmt::format("cannot write '{}'", file));
+      std::fprintf(stderr, "wrote %s\n", file.c_str());
+    };
   const bool report = !r.no_report && !r.report.empty();
   const auto json = open_output(r.json);
   if (report) occull::prepare_report_folder(r.report);
@@ -975,6 +985,8 @@ int main(int argc, char** argv) {
   og->add_option("--file", osg_args.file,
                  "instead of --scene: a file OSG reads (.osgt, .osgb, .ive, .obj, .3ds, .flt, ...), flown on its path "
                  "orbit or through (--path), verified against the ground truth of its triangles");
+  og->add_option("--png", osg_args.png,
+                 "write each row's last frame (first repeat) as PREFIX-ROW.png: what OSG drew");
   og->add_option("--export", osg_args.export_file,
                  "write the scene as an OSG file (.osgt, .osgb, .ive, ...: any format OSG writes) and exit");
 #endif

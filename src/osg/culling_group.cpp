@@ -7,22 +7,19 @@
 #include "gatherer.hpp"
 #include "osg_backend.hpp"
 
-#include <osg/BlendFunc>
-#include <osg/Camera>
 #include <osg/Geode>
-#include <osg/Projection>
 #include <osg/TriangleFunctor>
 #include <osgUtil/CullVisitor>
 #include <osgViewer/View>
 
 #include <fmt/format.h>
-#include <optional>
 #include <glm/gtc/type_ptr.hpp>
 
 #include <chrono>
-#include <utility>
 #include <map>
+#include <optional>
 #include <unordered_map>
+#include <utility>
 
 namespace osgOccull {
 using namespace occull;
@@ -131,6 +128,10 @@ OcclusionCullingGroup::OcclusionCullingGroup(const OcclusionCullingGroup& g, con
 }
 
 void OcclusionCullingGroup::start() {
+  // OSG's frustum and small-feature culling would judge the whole group by
+  // its bounding sphere (small-feature culling is not conservative); the
+  // group's culler does both, conservatively.
+  setCullingActive(false);
   state_ = std::make_shared<State>();
   state_->opaque = state_->scene.add_material({"opaque"});
   Material glass{"translucent"};
@@ -159,8 +160,6 @@ const CameraFrame* OcclusionCullingGroup::last_frame(const ::osg::Camera* camera
   const auto it = state_->cameras.find(camera);
   return it == state_->cameras.end() ? nullptr : &it->second.frame;
 }
-
-::osg::BoundingSphere OcclusionCullingGroup::computeBound() const { return ::osg::Group::computeBound(); }
 
 void OcclusionCullingGroup::traverse(::osg::NodeVisitor& nv) {
   if (nv.getVisitorType() != ::osg::NodeVisitor::CULL_VISITOR) {

@@ -135,7 +135,7 @@ class EglWindow : public osgViewer::GraphicsWindowEmbedded {
 }  // namespace
 
 HeadlessViewer::HeadlessViewer(int width, int height, osgViewer::ViewerBase::ThreadingModel model)
-    : context_(gl::Context::create({.debug = false, .compatibility = true})) {
+    : context_(gl::Context::create({.debug = false, .compatibility = true})), width_(width), height_(height) {
   glGenFramebuffers(1, &fbo_);
   glGenRenderbuffers(2, renderbuffers_);
   glBindRenderbuffer(GL_RENDERBUFFER, renderbuffers_[0]);
@@ -183,6 +183,21 @@ void HeadlessViewer::set_scene(::osg::Node* scene) {
     viewer_->realize();
     realized_ = true;
   }
+}
+
+std::vector<std::uint8_t> HeadlessViewer::read_rgba() {
+  viewer_->stopThreading();
+  context_->make_current();
+  std::vector<std::uint8_t> rgba(std::size_t(width_) * std::size_t(height_) * 4);
+  glBindFramebuffer(GL_READ_FRAMEBUFFER, fbo_);
+  glReadBuffer(GL_COLOR_ATTACHMENT0);
+  glPixelStorei(GL_PACK_ALIGNMENT, 1);
+  glReadPixels(0, 0, width_, height_, GL_RGBA, GL_UNSIGNED_BYTE, rgba.data());
+  const std::size_t row = std::size_t(width_) * 4;
+  for (int y = 0; y < height_ / 2; ++y)
+    std::swap_ranges(rgba.begin() + std::ptrdiff_t(row * std::size_t(y)), rgba.begin() + std::ptrdiff_t(row * std::size_t(y + 1)),
+                     rgba.begin() + std::ptrdiff_t(row * std::size_t(height_ - 1 - y)));
+  return rgba;
 }
 
 double HeadlessViewer::frame(const View& view, double time_s) {
@@ -329,6 +344,7 @@ BenchResult run_osg_bench(const OsgBenchConfig& config, const ProgressFn& progre
         run.frames.push_back(stats);
       }
       run.longest_miss_frames = misses.longest();
+      if (config.last_frame && rep == 0) config.last_frame(row, config.width, config.height, device->read_rgba());
       device->set_scene(nullptr);  // the group hands back its queries, the graph its GL objects
       result.runs.push_back(std::move(run));
       retired = std::move(device);

@@ -27,8 +27,9 @@
 // uses: the model-view matrix at the group and the projection OSG applied.
 //
 // What applies inside the group: occull's culling. OSG's own frustum and
-// small-feature culling stop at the group's boundary (it keeps the group's
-// drawable from being culled); outside the group everything is as before.
+// small-feature culling stop at the group's boundary (the group and its
+// drawable are never culled by OSG; its culler does frustum culling
+// conservatively); outside the group everything is as before.
 // Translucent drawables (a state set with the transparent bin, or blending
 // on) never occlude; they are drawn after the group's opaque ones, back to
 // front. LOD and Switch nodes contribute the children active when the scene
@@ -119,7 +120,6 @@ class OcclusionCullingGroup : public ::osg::Group {
   [[nodiscard]] const std::string& algorithm() const noexcept { return algorithm_; }
 
   void traverse(::osg::NodeVisitor& nv) override;
-  ::osg::BoundingSphere computeBound() const override;
   void releaseGLObjects(::osg::State* state = nullptr) const override;
 
   /// The objects as gathered in the last frame (index = occull::ObjectId; an entry

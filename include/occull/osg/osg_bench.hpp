@@ -8,6 +8,8 @@
 
 #include <osgViewer/Viewer>
 
+#include <cstdint>
+#include <functional>
 #include <memory>
 
 #include <string>
@@ -37,11 +39,15 @@ class HeadlessViewer {
   /// One frame of `view` (its view and projection matrices) at `time_s`
   /// seconds: viewer.frame(), closed by glFinish. Returns its wall time, ms.
   double frame(const occull::View& view, double time_s);
+  /// The last frame's colour, RGBA8, top row first (a PNG's order). Stops
+  /// OSG's draw thread first (threaded models).
+  [[nodiscard]] std::vector<std::uint8_t> read_rgba();
   [[nodiscard]] osgViewer::Viewer& viewer() noexcept { return *viewer_; }
   [[nodiscard]] ::osg::Camera& camera() noexcept { return *viewer_->getCamera(); }
 
  private:
   std::unique_ptr<occull::gl::Context> context_;
+  int width_, height_;
   GLuint fbo_ = 0;
   GLuint renderbuffers_[2] = {0, 0};  // colour, depth
   ::osg::ref_ptr<osgViewer::Viewer> viewer_;
@@ -80,6 +86,10 @@ struct OsgBenchConfig {
   /// (CullDrawThreadPerContext); the others are refused (see culling_group.hpp).
   std::string threading = "single";
   occull::Options options;     ///< base options of the occull rows
+  /// When set, called with each row's last timed frame of the first repeat:
+  /// the row, width, height and RGBA8 pixels, top row first.
+  std::function<void(const std::string& row, int width, int height, const std::vector<std::uint8_t>& rgba)>
+      last_frame;
 };
 
 /// Runs every row over the same frames: per row and repeat a fresh
