@@ -967,29 +967,6 @@ int main(int argc, char** argv) {
                 "around 2 m circles; the hierarchy and the cullers follow")
       ->capture_default_str();
 
-#ifdef OCCULL_OSG
-  OsgArgs osg_args;
-  osg_args.run.report.clear();
-  auto* og = app.add_subcommand(
-      "osg", "occull's cullers inside OpenSceneGraph beside OSG's own OcclusionQueryNode, in one headless OSG "
-             "viewer, every frame checked against occull's ground truth");
-  add_run_options(og, osg_args.run, "row");
-  og->add_option("--rows", osg_args.rows,
-                 "comma-separated rows (default: osg,oqn,oqn-strict,vfc,chcpp,nohc,grid):\n" +
-                     osgOccull::describe_osg_rows());
-  og->add_option("--threading", osg_args.threading,
-                 "osgViewer threading model: single (SingleThreaded) or cull-draw (CullDrawThreadPerContext); "
-                 "the models that draw while the next frame is culled are refused")
-      ->capture_default_str();
-  og->add_option("--report", osg_args.run.report, "write report.md, SVG charts, JSON and CSV into this folder");
-  og->add_option("--file", osg_args.file,
-                 "instead of --scene: a file OSG reads (.osgt, .osgb, .ive, .obj, .3ds, .flt, ...), flown on its path "
-                 "orbit or through (--path), verified against the ground truth of its triangles");
-  og->add_option("--png", osg_args.png,
-                 "write each row's last frame (first repeat) as PREFIX-ROW.png: what OSG drew");
-  og->add_option("--export", osg_args.export_file,
-                 "write the scene as an OSG file (.osgt, .osgb, .ive, ...: any format OSG writes) and exit");
-#endif
 
   SweepArgs sweep;
   sweep.bench.algos = "grid";
@@ -1122,6 +1099,30 @@ int main(int argc, char** argv) {
   up->add_option("--moving", upkeep.moving, "fraction moved every frame")->capture_default_str();
   up->add_option("--frames", upkeep.frames, "frames")->capture_default_str();
   up->add_option("--seed", upkeep.seed, "random seed")->capture_default_str();
+
+#ifdef OCCULL_OSG
+  OsgArgs osg_args;
+  osg_args.run.report.clear();
+  auto* og = app.add_subcommand(
+      "osg", "occull's cullers inside OpenSceneGraph beside OSG's own OcclusionQueryNode, in one headless OSG "
+             "viewer, every frame checked against occull's ground truth");
+  add_run_options(og, osg_args.run, "row");
+  og->add_option("--rows", osg_args.rows,
+                 "comma-separated rows (default: osg,oqn,oqn-strict,vfc,chcpp,nohc,grid):\n" +
+                     osgOccull::describe_osg_rows());
+  og->add_option("--threading", osg_args.threading,
+                 "osgViewer threading model: single (SingleThreaded) or cull-draw (CullDrawThreadPerContext); "
+                 "the models that draw while the next frame is culled are refused")
+      ->capture_default_str();
+  og->add_option("--report", osg_args.run.report, "write report.md, SVG charts, JSON and CSV into this folder");
+  og->add_option("--file", osg_args.file,
+                 "instead of --scene: a file OSG reads (.osgt, .osgb, .ive, .obj, .3ds, .flt, ...), flown on its path "
+                 "orbit or through (--path), verified against the ground truth of its triangles");
+  og->add_option("--png", osg_args.png,
+                 "write each row's last frame (first repeat) as PREFIX-ROW.png: what OSG drew");
+  og->add_option("--export", osg_args.export_file,
+                 "write the scene as an OSG file (.osgt, .osgb, .ive, ...: any format OSG writes) and exit");
+#endif
 
   // An unknown command: name it and list the valid ones (CLI11 would only
   // say that a subcommand is required).
