@@ -159,6 +159,13 @@ HeadlessViewer::HeadlessViewer(int width, int height, osgViewer::ViewerBase::Thr
   camera->setReadBuffer(GL_COLOR_ATTACHMENT0);
   camera->setComputeNearFarMode(::osg::CullSettings::DO_NOT_COMPUTE_NEAR_FAR);
   camera->setClearColor({0.55f, 0.65f, 0.8f, 1.0f});
+  // A sun fixed in the world (+Y up, as occull's scenes) and some sky: OSG's
+  // default head light leaves every surface seen edge-on black.
+  viewer_->setLightingMode(::osg::View::SKY_LIGHT);
+  ::osg::Light* sun = viewer_->getLight();
+  sun->setPosition({0.4f, 1.0f, 0.6f, 0.0f});
+  sun->setAmbient({0.45f, 0.45f, 0.45f, 1.0f});
+  sun->setDiffuse({0.7f, 0.7f, 0.7f, 1.0f});
 }
 
 HeadlessViewer::~HeadlessViewer() {
