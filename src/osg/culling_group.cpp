@@ -74,20 +74,10 @@ struct OcclusionCullingGroup::State {
   unsigned gathered_frame = ~0u;
   std::unordered_map<std::uint64_t, ObjectId> ids;            // instance path's key -> object
   std::unordered_map<const ::osg::Drawable*, MeshId> meshes;  // shared geometry: one mesh per drawable
-  std::unordered_map<std::uint64_t, ::osg::ref_ptr<::osg::StateSet>> merged;  // state-set list's key -> merged
+  detail::MergedStates merged;                               // state-set list's key -> merged
   std::vector<std::uint64_t> state_keys;                      // per object: its list's key
   std::vector<std::uint64_t> seen;                            // per object: the last walk that met it
   std::uint64_t walk = 0;
-  // The state sets of a path merged into one (null for none), one per list.
-  ::osg::ref_ptr<::osg::StateSet> merged_state(std::span<const ::osg::StateSet* const> states, std::uint64_t key) {
-    if (states.empty()) return nullptr;
-    auto [it, added] = merged.try_emplace(key);
-    if (added) {
-      it->second = new ::osg::StateSet;
-      for (const ::osg::StateSet* ss : states) it->second->merge(*ss);
-    }
-    return it->second;
-  }
   std::map<const ::osg::Camera*, CameraCuller> cameras;
   bool warned_view = false;
   double gather_ms = 0.0;  // the last gather's wall time
@@ -198,7 +188,7 @@ void OcclusionCullingGroup::gather(unsigned frame_number) {
       }
       if (s.state_keys[id] != state_key) {
         s.state_keys[id] = state_key;
-        inst.state = s.merged_state(states, state_key);
+        inst.state = s.merged.get(states, state_key);
         // (a change of translucency keeps the object's class: it is re-added when it moves in the graph)
       }
       return;
@@ -214,7 +204,7 @@ void OcclusionCullingGroup::gather(unsigned frame_number) {
       info.surface_area = count.area;
       mesh_it->second = s.scene.add_mesh(info);
     }
-    ::osg::ref_ptr<::osg::StateSet> merged = s.merged_state(states, state_key);
+    ::osg::ref_ptr<::osg::StateSet> merged = s.merged.get(states, state_key);
     const bool translucent = is_translucent(merged.get());
     const ObjectId id = s.scene.add_object(mesh_it->second, translucent ? s.translucent : s.opaque,
                                            to_glm(to_group), occluder_of(path, translucent));

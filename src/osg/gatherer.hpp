@@ -17,6 +17,7 @@
 #include <cstdint>
 #include <span>
 #include <string>
+#include <unordered_map>
 #include <vector>
 
 namespace osgOccull::detail {
@@ -49,6 +50,25 @@ inline occull::OccluderClass occluder_of(const ::osg::NodePath& path, bool trans
   }
   return occull::OccluderClass::sometimes;
 }
+
+// The state sets of a path merged into one, one per distinct list (keyed by
+// the list's running hash, as Gatherer gives it): what an instance is drawn
+// with. Null for a path without state sets.
+class MergedStates {
+ public:
+  ::osg::ref_ptr<::osg::StateSet> get(std::span<const ::osg::StateSet* const> states, std::uint64_t key) {
+    if (states.empty()) return nullptr;
+    auto [it, added] = merged_.try_emplace(key);
+    if (added) {
+      it->second = new ::osg::StateSet;
+      for (const ::osg::StateSet* s : states) it->second->merge(*s);
+    }
+    return it->second;
+  }
+
+ private:
+  std::unordered_map<std::uint64_t, ::osg::ref_ptr<::osg::StateSet>> merged_;
+};
 
 // Keys of node paths and of lists of state sets: a running hash, one entry
 // per depth, so a drawable's keys cost nothing to compute and nothing is

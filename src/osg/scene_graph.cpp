@@ -139,7 +139,7 @@ ImportedGraph import_graph(::osg::Node& root, const std::string& name) {
   ImportedGraph out{SceneBundle{Scene(name), {}, Lens{}}, {}, &root};
   Scene& scene = out.bundle.scene;
   std::unordered_map<const ::osg::Drawable*, MeshId> meshes;
-  std::unordered_map<std::uint64_t, ::osg::ref_ptr<::osg::StateSet>> merged;
+  detail::MergedStates merged;
   std::map<std::tuple<float, float, float, float, bool>, MaterialId> materials;
   auto found = [&](::osg::Drawable& drawable, const ::osg::NodePath& path, std::uint64_t, const ::osg::Matrix& to_root,
                    std::span<const ::osg::StateSet* const> states, std::uint64_t state_key) {
@@ -151,15 +151,7 @@ ImportedGraph import_graph(::osg::Node& root, const std::string& name) {
       drawable.accept(copy);
       mesh_it->second = scene.add_mesh(std::move(mesh));
     }
-    ::osg::ref_ptr<::osg::StateSet> state;
-    if (!states.empty()) {
-      auto [it, added] = merged.try_emplace(state_key);
-      if (added) {
-        it->second = new ::osg::StateSet;
-        for (const ::osg::StateSet* ss : states) it->second->merge(*ss);
-      }
-      state = it->second;
-    }
+    const ::osg::ref_ptr<::osg::StateSet> state = merged.get(states, state_key);
     const bool translucent = detail::is_translucent(state.get());
     const glm::vec4 colour = diffuse_of(state.get());
     auto [m, new_material] = materials.try_emplace({colour.r, colour.g, colour.b, colour.a, translucent}, 0);
