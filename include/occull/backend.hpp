@@ -13,6 +13,8 @@
 
 namespace occull {
 
+class DeviceCulling;
+
 /// Handle of an occlusion query in flight. Valid from issue_query() until
 /// result() returns; the backend may reuse the number afterwards.
 using QueryId = std::uint32_t;
@@ -38,6 +40,13 @@ struct BackendStats {
   std::uint64_t stalled_results = 0;   ///< results given up on and taken as visible (StallGuard)
   double wait_ms = 0.0;                ///< wall time blocked inside result(), milliseconds
   double backend_ms = 0.0;             ///< wall time inside any Backend call, milliseconds
+  /// GPU time of device culling (DeviceCulling), milliseconds: building
+  /// depth pyramids, and the test-and-write-commands dispatches. Objects the
+  /// device drew are known only once read back, so these two and the draw
+  /// counters of device draws are counted by whoever reads them
+  /// (RecordingBackend::finish_frame); the GL renderer alone leaves them 0.
+  double pyramid_ms = 0.0;
+  double device_cull_ms = 0.0;
 
   friend BackendStats operator-(const BackendStats& a, const BackendStats& b) noexcept {
     return {a.draw_calls - b.draw_calls,       a.triangles - b.triangles,
@@ -47,7 +56,8 @@ struct BackendStats {
             a.blocking_waits - b.blocking_waits, a.flushes - b.flushes,
             a.conditional_objects - b.conditional_objects, a.conditional_skipped - b.conditional_skipped,
             a.stalled_results - b.stalled_results,
-            a.wait_ms - b.wait_ms,             a.backend_ms - b.backend_ms};
+            a.wait_ms - b.wait_ms,             a.backend_ms - b.backend_ms,
+            a.pyramid_ms - b.pyramid_ms,       a.device_cull_ms - b.device_cull_ms};
   }
 };
 
@@ -104,6 +114,12 @@ class Backend {
   /// Asks the device to start work submitted so far without waiting for it
   /// (glFlush); helps queries finish while the culler does other work.
   virtual void flush() {}
+
+  /// Optional capability: culling and drawing on the device (GPU-driven
+  /// culling, occull/device_culling.hpp), or null when the backend has none
+  /// (the default). A decorator forwards its inner backend's. The object
+  /// belongs to the backend and lives as long as it.
+  [[nodiscard]] virtual DeviceCulling* device_culling() { return nullptr; }
 
   [[nodiscard]] virtual BackendStats stats() const = 0;
 };

@@ -1,0 +1,114 @@
+// occull — the depth pyramid and its conservative box test, on the CPU: the
+// reference the device's shaders (gl::Renderer's DeviceCulling, `hiz`)
+// implement line for line, and what the unit tests break on purpose.
+//
+// A box is found occluded only when every pixel it could cover already holds
+// something nearer than the box's nearest point. The rules that make it so,
+// each with the test in tests/depth_pyramid_test.cpp that fails without it
+// (PyramidRules switches each off):
+//
+//  1. Farthest depth per texel. Each texel of level k+1 holds the farthest
+//     of the (up to) 2×2 texels of level k it covers: max of the depth, or
+//     min with reversed-Z. A nearest-depth reduction would let one near
+//     texel hide a gap beside it.                 (FarthestDepthPerTexel)
+//  2. Sizes halve rounding up. Level k+1 is ceil(w/2) × ceil(h/2), its last
+//     texel of an odd edge covering the one texel left over. Halving
+//     rounding down (or starting from the previous power of two) drops that
+//     texel: a gap on an odd edge disappears.     (OddEdgesKeepTheirLastTexel)
+//  3. The box's screen rectangle is every pixel it touches: the box's 8
+//     corners projected, the rectangle widened by 1/64 pixel for rounding
+//     and sub-pixel vertex snapping, then floored to whole texels (a pixel
+//     is touched when the rectangle overlaps any part of it).
+//  4. The level is the coarsest one at which that rectangle, w × h texels
+//     at level 0, spans at most 2×2 texels: L = ceil(log2(max(w, h))), since
+//     w <= 2^L texels lie in at most two blocks of 2^L. All (up to four)
+//     texels at L are read. floor(log2) instead, or one level finer
+//     (a level "bias" of -1), leaves up to 3 blocks to 2 reads.
+//                                  (LevelIsTheCeilingOfLog2, LevelOneTooFineMissesAGap)
+//  5. Depth at the box's nearest point: the nearest of its 8 corners (depth
+//     is monotonic in the distance along the view axis, which is linear over
+//     the box, so a corner is nearest). A box's centre depth would hide its
+//     front poking through an occluder.           (DepthAtTheNearestCorner)
+//  6. Boxes crossing the near plane or behind the eye are visible: a corner
+//     with w <= 0 or in front of the near plane makes no meaningful screen
+//     rectangle. Dropping such corners (as some peers do) keeps only the far
+//     end of a box that reaches up to the eye.    (BoxesReachingTheEyeAreVisible)
+//  7. Ties are visible, and a margin of depth rounding: occluded only when
+//     the nearest depth is farther than the texel's by more than
+//     4e-6 × |depth| + 4e-7 (interpolated fragment depth rounds by a few
+//     ulps of the largest depth of its triangle).  (DepthTiesAreVisible)
+//  8. Reversed-Z: "farther" is smaller depth. Comparing as if it were
+//     standard depth turns every rule around.    (ReversedZComparesTheOtherWay)
+// Outside those rules a box is visible: an empty box, or a rectangle that
+// falls entirely off the image, is reported hidden only because nothing of it
+// can be drawn (the frustum test in front of the pyramid normally culls it).
+#pragma once
+
+#include "occull/geometry.hpp"
+
+#include <glm/mat4x4.hpp>
+
+#include <span>
+#include <vector>
+
+namespace occull {
+
+/// The rules of the header, each switchable to show what breaks without it
+/// (tests only; the defaults are the conservative test).
+struct PyramidRules {
+  bool farthest_reduction = true;  ///< rule 1; false: nearest depth per texel
+  bool round_sizes_up = true;      ///< rule 2; false: sizes halve rounding down
+  bool ceil_level = true;          ///< rule 4; false: floor(log2)
+  int level_bias = 0;              ///< rule 4; -1: one level too fine
+  bool nearest_corner = true;      ///< rule 5; false: depth at the box's centre
+  bool reaching_eye_visible = true;///< rule 6; false: corners behind the eye or near plane dropped
+  bool reversed_aware = true;      ///< rule 8; false: reversed-Z depth compared as standard
+  bool depth_margin = true;        ///< rule 7; false: occluded when the box's depth is not nearer (ties hidden)
+};
+
+/// The margin of rule 7: a texel of depth `far` (in the key order, see
+/// DepthPyramid) hides a box only if the box's nearest key exceeds far +
+/// depth_tolerance(far).
+[[nodiscard]] float depth_tolerance(float far_key) noexcept;
+
+/// The coarsest level at which a rectangle of `extent` texels at level 0
+/// (the larger of its width and height, >= 1) spans at most 2×2 texels:
+/// ceil(log2(extent)).
+[[nodiscard]] int pyramid_level_for(int extent) noexcept;
+
+/// A depth pyramid over a window-depth image, and the box test.
+class DepthPyramid {
+ public:
+  /// `depth`: width*height window depths as the device stores them (with
+  /// reversed-Z, larger is nearer), row-major, bottom row first (level 0).
+  /// Preconditions: width, height >= 1; depth.size() == width*height.
+  DepthPyramid(std::span<const float> depth, int width, int height, bool reversed_z,
+               const PyramidRules& rules = {});
+
+  /// Levels, from 0 (the image) to the one of 1×1 texel.
+  [[nodiscard]] int levels() const noexcept { return int(levels_.size()); }
+  [[nodiscard]] int width(int level) const { return levels_.at(std::size_t(level)).width; }
+  [[nodiscard]] int height(int level) const { return levels_.at(std::size_t(level)).height; }
+  /// Texel (x, y) of a level, as stored (device depth).
+  [[nodiscard]] float at(int level, int x, int y) const;
+  /// A level's texels, row-major, bottom row first.
+  [[nodiscard]] std::span<const float> level(int k) const { return levels_.at(std::size_t(k)).texels; }
+
+  /// Whether `box` (world space) is hidden behind the depth of the image as
+  /// seen through `view_proj` with clip conventions `clip` (its reversed_z
+  /// must be the pyramid's). False means "may be visible".
+  [[nodiscard]] bool occluded(const Aabb& box, const glm::mat4& view_proj, const ClipSpace& clip) const;
+
+ private:
+  struct Level {
+    int width = 0, height = 0;
+    std::vector<float> texels;
+  };
+  // Larger is farther: depth, or -depth with reversed-Z (unless broken).
+  [[nodiscard]] float key(float depth) const noexcept { return reversed_ && rules_.reversed_aware ? -depth : depth; }
+  std::vector<Level> levels_;
+  bool reversed_ = false;
+  PyramidRules rules_;
+};
+
+}  // namespace occull

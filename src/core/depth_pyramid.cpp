@@ -1,0 +1,110 @@
+// The depth pyramid's reference implementation: see depth_pyramid.hpp for
+// the rules. src/gl/renderer_device.cpp's shaders follow this file.
+#include "occull/depth_pyramid.hpp"
+
+#include <glm/vec4.hpp>
+
+#include <algorithm>
+#include <bit>
+#include <cassert>
+#include <cmath>
+#include <limits>
+
+namespace occull {
+
+float depth_tolerance(float far_key) noexcept { return 4e-6f * std::abs(far_key) + 4e-7f; }
+
+int pyramid_level_for(int extent) noexcept {
+  if (extent <= 1) return 0;
+  return std::bit_width(unsigned(extent - 1));  // ceil(log2(extent))
+}
+
+DepthPyramid::DepthPyramid(std::span<const float> depth, int width, int height, bool reversed_z,
+                           const PyramidRules& rules)
+    : reversed_(reversed_z), rules_(rules) {
+  assert(width >= 1 && height >= 1 && depth.size() == std::size_t(width) * std::size_t(height));
+  levels_.push_back({width, height, std::vector<float>(depth.begin(), depth.end())});
+  while (levels_.back().width > 1 || levels_.back().height > 1) {
+    const Level& src = levels_.back();
+    const auto halve = [&](int n) { return std::max(1, rules_.round_sizes_up ? (n + 1) / 2 : n / 2); };
+    Level dst{halve(src.width), halve(src.height), {}};
+    dst.texels.resize(std::size_t(dst.width) * std::size_t(dst.height));
+    for (int y = 0; y < dst.height; ++y)
+      for (int x = 0; x < dst.width; ++x) {
+        const int x0 = 2 * x, y0 = 2 * y;
+        const int x1 = std::min(x0 + 1, src.width - 1), y1 = std::min(y0 + 1, src.height - 1);
+        float v = src.texels[std::size_t(y0) * std::size_t(src.width) + std::size_t(x0)];
+        for (const auto& [sx, sy] : {std::pair{x1, y0}, std::pair{x0, y1}, std::pair{x1, y1}}) {
+          const float s = src.texels[std::size_t(sy) * std::size_t(src.width) + std::size_t(sx)];
+          const bool farther = key(s) > key(v);
+          if (farther == rules_.farthest_reduction) v = s;
+        }
+        dst.texels[std::size_t(y) * std::size_t(dst.width) + std::size_t(x)] = v;
+      }
+    levels_.push_back(std::move(dst));
+  }
+}
+
+float DepthPyramid::at(int level, int x, int y) const {
+  const Level& l = levels_.at(std::size_t(level));
+  return l.texels.at(std::size_t(y) * std::size_t(l.width) + std::size_t(x));
+}
+
+bool DepthPyramid::occluded(const Aabb& box, const glm::mat4& view_proj, const ClipSpace& clip) const {
+  if (box.empty()) return true;  // nothing to draw
+  const Level& base = levels_.front();
+  constexpr float inf = std::numeric_limits<float>::infinity();
+  float min_x = inf, min_y = inf, max_x = -inf, max_y = -inf;
+  float nearest = inf;  // key
+  int projected = 0;
+  for (int i = 0; i < 8; ++i) {
+    const glm::vec3 corner((i & 1) ? box.max.x : box.min.x, (i & 2) ? box.max.y : box.min.y,
+                           (i & 4) ? box.max.z : box.min.z);
+    const glm::vec4 c = view_proj * glm::vec4(corner, 1.0f);
+    const float ndc_z = c.z / c.w;
+    const bool before_near = clip.reversed_z ? ndc_z > 1.0f : ndc_z < clip.near_depth();
+    if (c.w <= 0.0f || before_near) {
+      if (rules_.reaching_eye_visible) return false;  // rule 6
+      continue;
+    }
+    ++projected;
+    const float depth = clip.depth == DepthRange::zero_to_one ? ndc_z : ndc_z * 0.5f + 0.5f;
+    nearest = std::min(nearest, key(depth));
+    const float px = (c.x / c.w * 0.5f + 0.5f) * float(base.width);
+    const float py = (c.y / c.w * 0.5f + 0.5f) * float(base.height);
+    min_x = std::min(min_x, px);
+    max_x = std::max(max_x, px);
+    min_y = std::min(min_y, py);
+    max_y = std::max(max_y, py);
+  }
+  if (projected == 0) return false;
+  if (!rules_.nearest_corner) {  // rule 5 broken: the centre's depth
+    const glm::vec4 c = view_proj * glm::vec4(box.center(), 1.0f);
+    const float ndc_z = c.z / c.w;
+    nearest = key(clip.depth == DepthRange::zero_to_one ? ndc_z : ndc_z * 0.5f + 0.5f);
+  }
+  // Rule 3: every pixel the rectangle touches, widened for rounding.
+  constexpr float margin = 1.0f / 64.0f;
+  const int x0 = std::max(0, int(std::floor(min_x - margin)));
+  const int y0 = std::max(0, int(std::floor(min_y - margin)));
+  const int x1 = std::min(base.width - 1, int(std::floor(max_x + margin)));
+  const int y1 = std::min(base.height - 1, int(std::floor(max_y + margin)));
+  if (x0 > x1 || y0 > y1) return true;  // off the image: nothing to draw
+  // Rule 4: the level where the rectangle spans at most 2×2 texels.
+  const int extent = std::max(x1 - x0 + 1, y1 - y0 + 1);
+  int level = rules_.ceil_level ? pyramid_level_for(extent) : std::bit_width(unsigned(extent)) - 1;
+  level = std::clamp(level + rules_.level_bias, 0, levels() - 1);
+  const Level& l = levels_[std::size_t(level)];
+  // Two texels from the rectangle's first along each axis (all of them at
+  // the right level), within the level.
+  const int tx = x0 >> level, ty = y0 >> level;
+  float farthest = -inf;
+  for (int y = ty; y <= std::min(ty + 1, l.height - 1); ++y)
+    for (int x = tx; x <= std::min(tx + 1, l.width - 1); ++x)
+      farthest = std::max(farthest, key(l.texels[std::size_t(y) * std::size_t(l.width) + std::size_t(x)]));
+  // Rule 7: ties and depth rounding are visible.
+  const float tolerance = rules_.depth_margin ? depth_tolerance(farthest) : 0.0f;
+  return rules_.depth_margin ? nearest > farthest + tolerance : nearest >= farthest;
+}
+
+}  // namespace occull
