@@ -84,6 +84,8 @@ struct AlgorithmSummary {
   double flushes_per_frame = 0.0;         ///< submissions to the device mid-frame (BackendStats::flushes)
   double cpu_ms_per_frame = 0.0;
   double gpu_ms_per_frame = 0.0;
+  double pyramid_ms_per_frame = 0.0;      ///< GPU time building depth pyramids (hiz)
+  double device_cull_ms_per_frame = 0.0;  ///< GPU time of device culling's dispatches (hiz)
   double model_ms_per_frame = 0.0;        ///< cost-model prediction (0 without --model)
   double cpu_us_per_node = 0.0;           ///< culler CPU time per visited node, microseconds (0: no nodes)
   double kernel_ms_per_frame = 0.0;       ///< process CPU time in the kernel (FrameStats::kernel_ms)

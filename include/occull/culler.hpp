@@ -146,6 +146,7 @@ class Culler {
       inner->render_conditional(objects, q, wait);
     }
     void flush() override { inner->flush(); }
+    [[nodiscard]] DeviceCulling* device_culling() override { return inner->device_culling(); }
     [[nodiscard]] BackendStats stats() const override { return inner->stats(); }
   };
   mutable DrawRecorder recorder_;  // drawn_objects() sorts its list once asked

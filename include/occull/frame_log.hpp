@@ -56,6 +56,7 @@ class LoggingBackend final : public Backend {
   [[nodiscard]] bool conditional_rendering() const override { return inner_.conditional_rendering(); }
   void render_conditional(std::span<const ObjectId> objects, QueryId q, ConditionalWait wait) override;
   void flush() override { inner_.flush(); }
+  [[nodiscard]] DeviceCulling* device_culling() override { return inner_.device_culling(); }
   [[nodiscard]] BackendStats stats() const override { return inner_.stats(); }
 
  private:

@@ -4,6 +4,7 @@
 #pragma once
 
 #include "occull/backend.hpp"
+#include "occull/device_culling.hpp"
 #include "occull/scene.hpp"
 
 #include <cstdint>
@@ -24,10 +25,17 @@ namespace occull {
 /// StallGuard (whose stand-in answers are not the device's): the results it
 /// sees are the ones conditional rendering used.
 ///
+/// Device culling (DeviceCulling, when the wrapped backend has it) passes
+/// through it too; the objects the device drew are read back at
+/// finish_frame() (DeviceCulling::read_drawn, after the timed frame) and
+/// recorded then.
+///
 /// Stats are the wrapped backend's, with the recorder's own time added to
-/// backend_ms: recording is backend work, not the culler's.
+/// backend_ms: recording is backend work, not the culler's; and with the
+/// device's draws (draw_calls, objects_rendered and triangles, one draw per
+/// object) and pass times (pyramid_ms, device_cull_ms) once read back.
 /// Precondition: `inner` and `scene` outlive this object.
-class RecordingBackend final : public Backend {
+class RecordingBackend final : public Backend, private DeviceCulling {
  public:
   RecordingBackend(Backend& inner, const Scene& scene) : inner_(inner), scene_(scene) {}
 
@@ -52,8 +60,19 @@ class RecordingBackend final : public Backend {
   void render_conditional(std::span<const ObjectId> objects, QueryId q, ConditionalWait wait) override;
   void flush() override { inner_.flush(); }
   [[nodiscard]] BackendStats stats() const override;
+  [[nodiscard]] DeviceCulling* device_culling() override {
+    return inner_.device_culling() ? static_cast<DeviceCulling*>(this) : nullptr;
+  }
 
  private:
+  // DeviceCulling, forwarded to the inner backend's; the frame's phases are noted.
+  [[nodiscard]] Visibility create_visibility() override { return inner_.device_culling()->create_visibility(); }
+  void destroy_visibility(Visibility v) override { inner_.device_culling()->destroy_visibility(v); }
+  void draw_previously_visible(Visibility v) override;
+  void build_depth_pyramid() override;
+  void draw_newly_visible(Visibility v, int texels) override;
+  DeviceCullingTimes read_drawn(std::vector<ObjectId>& out) override { return inner_.device_culling()->read_drawn(out); }
+
   // Appends the pending draws on query q to objects_ if `samples` > 0.
   void settle(QueryId q, std::uint64_t samples);
 
@@ -69,6 +88,8 @@ class RecordingBackend final : public Backend {
   std::vector<Pending> pending_;
   std::vector<ObjectId> pending_objects_;
   double own_ms_ = 0.0;  // time spent recording, added to backend_ms
+  bool device_used_ = false;  // a device-culling call this frame: its draws are read back at finish_frame
+  BackendStats device_;       // the device's draws and pass times read back so far
 };
 
 }  // namespace occull

@@ -51,6 +51,7 @@ class StallGuard final : public Backend {
     inner_.render_conditional(objects, q, wait);
   }
   void flush() override { inner_.flush(); }
+  [[nodiscard]] DeviceCulling* device_culling() override { return inner_.device_culling(); }
   [[nodiscard]] BackendStats stats() const override;
 
  private:

@@ -18,6 +18,8 @@ struct FrameStats {
   double gpu_ms = 0.0;    ///< GPU time from timer queries (0 when unavailable)
   double model_ms = 0.0;  ///< the NOHC cost model's prediction of this frame (occull bench --model)
   double kernel_ms = 0.0; ///< CPU time the whole process spent in the kernel during the frame
+  double pyramid_ms = 0.0;      ///< GPU time building depth pyramids (device culling: hiz)
+  double device_cull_ms = 0.0;  ///< GPU time of device culling's test-and-write-commands dispatches
 
   // What the operating system did during the frame (whole process, driver
   // threads included): page faults are allocator churn, not algorithm cost.

@@ -19,6 +19,7 @@ struct Timed {
 }  // namespace
 
 void RecordingBackend::start_frame() {
+  device_used_ = false;
   objects_.clear();
   boxes_.clear();
   sizes_.clear();
@@ -32,6 +33,31 @@ void RecordingBackend::finish_frame(const std::function<std::uint64_t(QueryId)>&
     settle(q, in_flight_result(q));
   }
   pending_objects_.clear();
+  if (device_used_) {
+    device_used_ = false;
+    const std::size_t begin = objects_.size();
+    const DeviceCullingTimes times = inner_.device_culling()->read_drawn(objects_);
+    for (std::size_t k = begin; k < objects_.size(); ++k) device_.triangles += scene_.object(objects_[k]).triangles;
+    device_.draw_calls += objects_.size() - begin;
+    device_.objects_rendered += objects_.size() - begin;
+    device_.pyramid_ms += times.pyramid_ms;
+    device_.device_cull_ms += times.cull_ms;
+  }
+}
+
+void RecordingBackend::draw_previously_visible(Visibility v) {
+  device_used_ = true;
+  inner_.device_culling()->draw_previously_visible(v);
+}
+
+void RecordingBackend::build_depth_pyramid() {
+  device_used_ = true;
+  inner_.device_culling()->build_depth_pyramid();
+}
+
+void RecordingBackend::draw_newly_visible(Visibility v, int texels) {
+  device_used_ = true;
+  inner_.device_culling()->draw_newly_visible(v, texels);
 }
 
 void RecordingBackend::render(std::span<const ObjectId> objects) {
@@ -84,6 +110,11 @@ void RecordingBackend::settle(QueryId q, std::uint64_t samples) {
 BackendStats RecordingBackend::stats() const {
   BackendStats s = inner_.stats();
   s.backend_ms += own_ms_;
+  s.draw_calls += device_.draw_calls;
+  s.objects_rendered += device_.objects_rendered;
+  s.triangles += device_.triangles;
+  s.pyramid_ms += device_.pyramid_ms;
+  s.device_cull_ms += device_.device_cull_ms;
   return s;
 }
 

@@ -14,6 +14,7 @@ Registration chc_registration();
 Registration chcpp_registration();
 Registration nohc_registration();
 Registration grid_registration();
+Registration hiz_registration();
 Registration auto_registration();
 Registration tilevfc_registration();
 Registration pertile_registration();

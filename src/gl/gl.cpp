@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <stdexcept>
+#include <initializer_list>
 #include <string>
+#include <string_view>
 
 namespace occull::gl {
 
@@ -30,23 +32,18 @@ GLuint compile(const char* name, GLenum stage, const std::string& source) {
     glGetShaderInfoLog(shader, len, nullptr, log.data());
     glDeleteShader(shader);
     throw std::runtime_error(std::string("compiling the ") + name + " " +
-                             (stage == GL_VERTEX_SHADER ? "vertex" : "fragment") +
+                             (stage == GL_VERTEX_SHADER ? "vertex" : stage == GL_COMPUTE_SHADER ? "compute" : "fragment") +
                              " shader failed: " + log);
   }
   return shader;
 }
 
-}  // namespace
-
-GLuint make_program(const char* name, const std::string& vertex, const std::string& fragment) {
-  const GLuint vs = compile(name, GL_VERTEX_SHADER, vertex);
-  const GLuint fs = compile(name, GL_FRAGMENT_SHADER, fragment);
+// Links the compiled `shaders` (and deletes them); throws with the log.
+GLuint link(const char* name, std::initializer_list<GLuint> shaders) {
   const GLuint program = glCreateProgram();
-  glAttachShader(program, vs);
-  glAttachShader(program, fs);
+  for (GLuint s : shaders) glAttachShader(program, s);
   glLinkProgram(program);
-  glDeleteShader(vs);
-  glDeleteShader(fs);
+  for (GLuint s : shaders) glDeleteShader(s);
   GLint ok = GL_FALSE;
   glGetProgramiv(program, GL_LINK_STATUS, &ok);
   if (!ok) {
@@ -58,6 +55,26 @@ GLuint make_program(const char* name, const std::string& vertex, const std::stri
     throw std::runtime_error(std::string("linking the ") + name + " program failed: " + log);
   }
   return program;
+}
+
+}  // namespace
+
+GLuint make_program(const char* name, const std::string& vertex, const std::string& fragment) {
+  const GLuint vs = compile(name, GL_VERTEX_SHADER, vertex);
+  const GLuint fs = compile(name, GL_FRAGMENT_SHADER, fragment);
+  return link(name, {vs, fs});
+}
+
+bool has_extension(const char* name) {
+  GLint n = 0;
+  glGetIntegerv(GL_NUM_EXTENSIONS, &n);
+  for (GLint i = 0; i < n; ++i)
+    if (std::string_view(reinterpret_cast<const char*>(glGetStringi(GL_EXTENSIONS, GLuint(i)))) == name) return true;
+  return false;
+}
+
+GLuint make_compute_program(const char* name, const std::string& source) {
+  return link(name, {compile(name, GL_COMPUTE_SHADER, source)});
 }
 
 }  // namespace occull::gl

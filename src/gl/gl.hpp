@@ -20,6 +20,11 @@ void check_error(const char* where);
 /// Compiles and links a program from vertex and fragment source; throws
 /// std::runtime_error with the info log on failure.
 GLuint make_program(const char* name, const std::string& vertex, const std::string& fragment);
+/// Whether the current context lists extension `name`.
+[[nodiscard]] bool has_extension(const char* name);
+
+/// The same for one compute shader.
+GLuint make_compute_program(const char* name, const std::string& source);
 
 /// State glReadPixels depends on: the framebuffer read from, no pixel-pack
 /// buffer (else it writes into that buffer), tight rows of `alignment`.

@@ -189,6 +189,7 @@ void Renderer::Impl::multi_draw(std::span<const ObjectId> ids) {
     indirect_offset = 0;
   }
   glNamedBufferSubData(indirect_buffer, indirect_offset, bytes, commands.data());
+  glBindBuffer(GL_DRAW_INDIRECT_BUFFER, indirect_buffer);  // device draws bind their own
   glMultiDrawElementsIndirect(GL_TRIANGLES, GL_UNSIGNED_INT,
                               reinterpret_cast<const void*>(indirect_offset), GLsizei(commands.size()),
                               0);
@@ -196,7 +197,7 @@ void Renderer::Impl::multi_draw(std::span<const ObjectId> ids) {
 }
 
 void Renderer::Impl::upload_dynamic_transforms() {
-  if (!options.multi_draw) return;  // single draws pass each matrix with its draw
+  if (!options.multi_draw && !device) return;  // single draws pass each matrix with its draw
   for (ObjectId id : scene.dynamic_objects()) {
     glNamedBufferSubData(object_buffer, GLintptr(id * sizeof(glm::mat4)), sizeof(glm::mat4),
                          glm::value_ptr(scene.object(id).transform));
@@ -211,8 +212,10 @@ void Renderer::Impl::upload_dynamic_transforms() {
 
 // Context state, camera and per-frame bookkeeping of a pass over `view`;
 // the targets keep what they hold.
-void Renderer::Impl::prepare_pass(const View& view) {
+void Renderer::Impl::prepare_pass(const View& v) {
+  view = v;
   clip = view.clip;
+  if (device) device->in_frame = false;
   if (scene.objects().size() > object_capacity)
     throw std::logic_error(fmt::format("gl::Renderer: the scene has {} objects, {} more than when the renderer was "
                                        "made; objects added later need a new renderer (ids removed and reused are fine)",
@@ -275,6 +278,7 @@ double Renderer::end_frame() {
     glDepthMask(GL_TRUE);
     g.translucent.clear();
   }
+  if (g.device && g.device->translucent_pending) g.draw_device_translucent();
   if (g.timer_supported) glEndQuery(GL_TIME_ELAPSED);
   glFinish();
   // Conditional draws whose query the culler has not read: the device is

@@ -13,6 +13,7 @@
 #include <fmt/format.h>
 
 #include <array>
+#include <memory>
 #include <stdexcept>
 #include <vector>
 
@@ -22,6 +23,13 @@ namespace detail {
 struct MaterialData {
   glm::vec4 color;  // alpha 1 for opaque materials
   GLint lights = 0;  // shading cost: extra lights evaluated per fragment
+};
+
+// An object's shading as device draws read it (an instanced attribute).
+struct ObjectShading {
+  glm::vec4 color;
+  GLint lights = 0;
+  GLint pad[3] = {0, 0, 0};
 };
 
 // Layout of glMultiDrawElementsIndirect's commands.
@@ -35,6 +43,32 @@ struct DrawCommand {
 constexpr GLsizeiptr kBoxCapacity = 1 << 16;
 
 constexpr QueryId kNoQuery = ~QueryId(0);  // no query: flush() is not about one
+
+// Device culling (renderer_device.cpp): made on the first DeviceCulling call.
+struct DeviceState {
+  GLuint cull_program = 0, pyramid_program = 0, draw_program = 0, draw_vao = 0;
+  GLuint objects = 0;    // DeviceObject per object (see renderer_device.cpp)
+  GLuint shading = 0;    // ObjectShading per object (its material's), an instanced attribute of device draws
+  GLuint drawn = 0;      // per object: drawn in this frame (1) or not (0)
+  GLuint commands = 0;   // 3 regions of one DrawCommand per object: phase 1, phase 2 opaque, phase 2 translucent
+  GLuint counts = 0;     // commands written to each region (compacted draws)
+  GLuint pyramid = 0;    // R32F, mip k is level k+1 of the pyramid (level 0 is the depth target)
+  std::vector<std::array<int, 2>> level_size;  // pyramid levels from 0 (the depth target)
+  std::vector<GLuint> visibility;  // Visibility -> buffer of a bit (uint) per object; 0 when free
+  std::uint64_t uploaded_revision = 0;  // Scene::placement_revision() of the records on the device
+  bool compact = false;  // glMultiDrawElementsIndirectCount available: commands compacted
+  void (*draw_count)(GLenum, GLenum, const void*, GLintptr, GLsizei, GLsizei) = nullptr;
+  bool in_frame = false;            // the frame's records, uniforms and cleared buffers are set
+  bool translucent_pending = false; // phase 2 wrote translucent draws for end_frame
+  std::array<GLuint, 6> stamps{};   // timestamps around the two cull dispatches and the pyramid build
+  std::uint32_t stamps_written = 0; // bit k: stamps[k] was written this frame
+  bool timestamps = false;          // the device has GL_TIMESTAMP
+  bool pyramid_built = false;       // build_depth_pyramid() ran this frame
+  GLint u_phase = -1, u_objects = -1, u_region = -1, u_view_proj = -1, u_planes = -1, u_viewport = -1,
+        u_levels = -1, u_level_size = -1, u_clip = -1, u_compact = -1, u_texels = -1;
+  GLint u_draw_view_proj = -1, u_draw_eye = -1, u_draw_background = -1, u_draw_fog = -1;
+  GLint u_pyr_from_depth = -1, u_pyr_src_size = -1, u_pyr_dst_size = -1, u_pyr_reversed = -1;
+};
 
 }  // namespace detail
 
@@ -62,7 +96,8 @@ struct Renderer::Impl {
   [[nodiscard]] GLenum depth_less() const { return clip.reversed_z ? GL_GREATER : GL_LESS; }
   [[nodiscard]] GLenum depth_less_equal() const { return clip.reversed_z ? GL_GEQUAL : GL_LEQUAL; }
   [[nodiscard]] float depth_far() const { return clip.reversed_z ? 0.0f : 1.0f; }
-  GLuint fbo = 0, color_rb = 0, depth_rb = 0, id_rb = 0;
+  GLuint fbo = 0, color_rb = 0, id_rb = 0;
+  GLuint depth_texture = 0;  // a texture, not a renderbuffer: device culling builds its pyramid from it
   GLuint timer = 0;
   bool timer_supported = false;
   bool write_ids = true;
@@ -124,6 +159,8 @@ struct Renderer::Impl {
   }
   GLuint truth_query = 0;             // GL_SAMPLES_PASSED, for visible_pixels only
   std::vector<std::uint32_t> pixel_counts;  // per object, scratch of visible_pixels
+  View view;                          // of the current pass
+  std::unique_ptr<detail::DeviceState> device;  // made by the first DeviceCulling call
   GLuint indirect_buffer = 0;         // multi-draw commands, refilled every frame
   GLsizeiptr indirect_capacity = 0, indirect_offset = 0;
   std::vector<detail::DrawCommand> commands;
@@ -145,6 +182,22 @@ struct Renderer::Impl {
   // `objects` into `opaque` (cleared first) and `translucent` (appended to),
   // each in the order given.
   void split_translucent(std::span<const ObjectId> objects, std::vector<ObjectId>& translucent_out);
+  // Binds the per-object index buffer as attribute 2 (one per instance) of `vao`.
+  void add_object_attribute(GLuint vao) const;
+  // The scene program and vertex array of device draws (material per object).
+  // `shading_buffer` holds a detail::ObjectShading per object.
+  void create_device_draw(GLuint& program, GLuint& vao, GLuint shading_buffer) const;
+  // Device culling (renderer_device.cpp).
+  void create_device();
+  void destroy_device();
+  void start_device_frame();
+  void write_device_records(ObjectId id);
+  void device_draw(int region, BackendStats& stats);
+  void dispatch_cull(int phase, GLuint visibility);
+  // The buffer of visibility `v`; std::logic_error naming `call` when there is none.
+  GLuint visibility_buffer(DeviceCulling::Visibility v, const char* call) const;
+  void draw_device_translucent();
+  void stamp(int k);
   // `opaque` by material, stably (a front-to-back order within a material survives).
   void sort_opaque_by_material();
 };

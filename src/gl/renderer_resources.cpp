@@ -28,11 +28,24 @@ using detail::MaterialData;
 // uniforms set with the draw (as scene-graph engines do); under
 // OCCULL_MULTI_DRAW (one multi-draw per material run) they come from the
 // object buffer, indexed by the instance attribute. The material is a
-// uniform in both: every draw or multi-draw covers one material.
+// uniform in both: every draw or multi-draw covers one material. Device
+// draws (OCCULL_INSTANCE_ATTRIBUTES, renderer_device.cpp) cover many
+// materials: the object's matrix, colour and lights are instanced vertex
+// attributes (each command's base instance is its object), fetched once per
+// instance rather than read from a buffer per vertex (which a software
+// rasteriser pays per vertex lane) and handed to the fragments flat.
 const char* kSceneVertex = R"(
 layout(location = 0) in vec3 a_position;
 layout(location = 1) in vec3 a_normal;
-#ifdef OCCULL_MULTI_DRAW
+#if defined(OCCULL_INSTANCE_ATTRIBUTES)
+layout(location = 2) in uint a_object;
+layout(location = 3) in mat4 a_model;  // locations 3 to 6
+layout(location = 7) in vec4 a_color;
+layout(location = 8) in int a_lights;
+flat out uint v_object;
+flat out vec4 v_color;
+flat out int v_lights;
+#elif defined(OCCULL_MULTI_DRAW)
 layout(location = 2) in uint a_object;
 layout(std430, binding = 0) readonly buffer Objects { mat4 models[]; };
 flat out uint v_object;
@@ -43,7 +56,12 @@ uniform mat4 u_view_proj;
 out vec3 v_world;
 out vec3 v_normal;
 void main() {
-#ifdef OCCULL_MULTI_DRAW
+#if defined(OCCULL_INSTANCE_ATTRIBUTES)
+  mat4 m = a_model;
+  v_object = a_object;
+  v_color = a_color;
+  v_lights = a_lights;
+#elif defined(OCCULL_MULTI_DRAW)
   mat4 m = models[a_object];
   v_object = a_object;
 #else
@@ -59,12 +77,21 @@ void main() {
 // Shading cost: `lights` extra point lights, placed around the fragment by a
 // fixed pattern, each evaluated with a full Blinn-Phong term.
 const char* kSceneFragment = R"(
+#ifdef OCCULL_INSTANCE_ATTRIBUTES
+flat in vec4 v_color;
+flat in int v_lights;
+#define MATERIAL_COLOR v_color
+#define MATERIAL_LIGHTS v_lights
+#else
 uniform vec4 u_color;
 uniform int u_lights;
+#define MATERIAL_COLOR u_color
+#define MATERIAL_LIGHTS u_lights
+#endif
 uniform vec3 u_eye;
 uniform vec3 u_background;
 uniform float u_fog_distance;
-#ifdef OCCULL_MULTI_DRAW
+#if defined(OCCULL_MULTI_DRAW) || defined(OCCULL_INSTANCE_ATTRIBUTES)
 flat in uint v_object;
 #else
 uniform uint u_object;
@@ -79,8 +106,10 @@ void main() {
   const vec3 sun = normalize(vec3(0.45, 0.8, 0.35));
   float diffuse = max(dot(n, sun), 0.0);
   float sky = 0.5 + 0.5 * n.y;
-  vec3 c = u_color.rgb * (0.25 + 0.25 * sky + 0.6 * diffuse);
-  for (int i = 0; i < u_lights; ++i) {
+  vec4 color = MATERIAL_COLOR;
+  int lights = MATERIAL_LIGHTS;
+  vec3 c = color.rgb * (0.25 + 0.25 * sky + 0.6 * diffuse);
+  for (int i = 0; i < lights; ++i) {
     float fi = float(i);
     vec3 light = v_world + vec3(sin(fi * 1.7) * 8.0, 4.0 + 2.0 * cos(fi * 2.3), cos(fi * 1.3) * 8.0);
     vec3 l = light - v_world;
@@ -88,12 +117,12 @@ void main() {
     l *= inversesqrt(d2);
     vec3 h = normalize(l + to_eye);
     float spec = pow(max(dot(n, h), 0.0), 32.0);
-    c += (u_color.rgb * max(dot(n, l), 0.0) + vec3(spec)) * (0.4 / (1.0 + 0.08 * d2)) / float(u_lights);
+    c += (color.rgb * max(dot(n, l), 0.0) + vec3(spec)) * (0.4 / (1.0 + 0.08 * d2)) / float(lights);
   }
   float fog = clamp(length(u_eye - v_world) / u_fog_distance, 0.0, 1.0);
   c = mix(c, u_background, fog * fog * 0.6);
-  o_color = vec4(c, u_color.a);
-#ifdef OCCULL_MULTI_DRAW
+  o_color = vec4(c, color.a);
+#if defined(OCCULL_MULTI_DRAW) || defined(OCCULL_INSTANCE_ATTRIBUTES)
   o_id = v_object + 1u;
 #else
   o_id = u_object + 1u;
@@ -199,27 +228,22 @@ std::vector<QueryVertex> query_mesh() {
   return v;
 }
 
-bool has_extension(const char* name) {
-  GLint n = 0;
-  glGetIntegerv(GL_NUM_EXTENSIONS, &n);
-  for (GLint i = 0; i < n; ++i)
-    if (std::string_view(reinterpret_cast<const char*>(glGetStringi(GL_EXTENSIONS, GLuint(i)))) == name) return true;
-  return false;
-}
-
 }  // namespace
 
 void Renderer::Impl::create_targets() {
   glCreateRenderbuffers(1, &color_rb);
   glNamedRenderbufferStorage(color_rb, GL_RGBA8, options.width, options.height);
-  glCreateRenderbuffers(1, &depth_rb);
-  glNamedRenderbufferStorage(depth_rb, GL_DEPTH_COMPONENT32F, options.width, options.height);
+  glCreateTextures(GL_TEXTURE_2D, 1, &depth_texture);
+  glTextureStorage2D(depth_texture, 1, GL_DEPTH_COMPONENT32F, options.width, options.height);
+  glTextureParameteri(depth_texture, GL_TEXTURE_MIN_FILTER, GL_NEAREST);  // one level: complete without mipmaps
+  glTextureParameteri(depth_texture, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+  glTextureParameteri(depth_texture, GL_TEXTURE_COMPARE_MODE, GL_NONE);   // read as depth values
   glCreateRenderbuffers(1, &id_rb);
   glNamedRenderbufferStorage(id_rb, GL_R32UI, options.width, options.height);
   glCreateFramebuffers(1, &fbo);
   glNamedFramebufferRenderbuffer(fbo, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, color_rb);
   glNamedFramebufferRenderbuffer(fbo, GL_COLOR_ATTACHMENT1, GL_RENDERBUFFER, id_rb);
-  glNamedFramebufferRenderbuffer(fbo, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, depth_rb);
+  glNamedFramebufferTexture(fbo, GL_DEPTH_ATTACHMENT, depth_texture, 0);
   apply_draw_buffers();
   const GLenum status = glCheckNamedFramebufferStatus(fbo, GL_FRAMEBUFFER);
   if (status != GL_FRAMEBUFFER_COMPLETE)
@@ -265,13 +289,7 @@ void Renderer::Impl::create_scene_buffers() {
     materials.push_back({color, std::max(0, m.shading_cost)});
   }
 
-  if (options.multi_draw) {  // the object index of each multi-draw command's instance
-    glVertexArrayVertexBuffer(scene_vao, 1, object_index_buffer, 0, sizeof(std::uint32_t));
-    glVertexArrayBindingDivisor(scene_vao, 1, 1);
-    glVertexArrayAttribIFormat(scene_vao, 2, 1, GL_UNSIGNED_INT, 0);
-    glVertexArrayAttribBinding(scene_vao, 2, 1);
-    glEnableVertexArrayAttrib(scene_vao, 2);
-  }
+  if (options.multi_draw) add_object_attribute(scene_vao);
 
   const std::string header = options.multi_draw ? "#version 450 core\n#define OCCULL_MULTI_DRAW 1\n"
                                                  : "#version 450 core\n";
@@ -284,6 +302,38 @@ void Renderer::Impl::create_scene_buffers() {
   u_eye = glGetUniformLocation(scene_program, "u_eye");
   u_background = glGetUniformLocation(scene_program, "u_background");
   u_fog = glGetUniformLocation(scene_program, "u_fog_distance");
+}
+
+void Renderer::Impl::add_object_attribute(GLuint vao) const {
+  glVertexArrayVertexBuffer(vao, 1, object_index_buffer, 0, sizeof(std::uint32_t));
+  glVertexArrayBindingDivisor(vao, 1, 1);
+  glVertexArrayAttribIFormat(vao, 2, 1, GL_UNSIGNED_INT, 0);
+  glVertexArrayAttribBinding(vao, 2, 1);
+  glEnableVertexArrayAttrib(vao, 2);
+}
+
+void Renderer::Impl::create_device_draw(GLuint& program, GLuint& vao, GLuint shading_buffer) const {
+  const std::string header = "#version 450 core\n#define OCCULL_INSTANCE_ATTRIBUTES 1\n";
+  program = make_program("device draw", header + kSceneVertex, header + kSceneFragment);
+  vao = make_scene_vao(vertex_buffer, index_buffer);
+  add_object_attribute(vao);
+  // Binding 2: the object's model matrix (the object buffer), one per instance.
+  glVertexArrayVertexBuffer(vao, 2, object_buffer, 0, sizeof(glm::mat4));
+  glVertexArrayBindingDivisor(vao, 2, 1);
+  for (GLuint column = 0; column < 4; ++column) {
+    glVertexArrayAttribFormat(vao, 3 + column, 4, GL_FLOAT, GL_FALSE, column * sizeof(glm::vec4));
+    glVertexArrayAttribBinding(vao, 3 + column, 2);
+    glEnableVertexArrayAttrib(vao, 3 + column);
+  }
+  // Binding 3: its colour and lights (detail::MaterialData), one per instance.
+  glVertexArrayVertexBuffer(vao, 3, shading_buffer, 0, sizeof(detail::ObjectShading));
+  glVertexArrayBindingDivisor(vao, 3, 1);
+  glVertexArrayAttribFormat(vao, 7, 4, GL_FLOAT, GL_FALSE, offsetof(detail::ObjectShading, color));
+  glVertexArrayAttribIFormat(vao, 8, 1, GL_INT, offsetof(detail::ObjectShading, lights));
+  for (GLuint a : {7u, 8u}) {
+    glVertexArrayAttribBinding(vao, a, 3);
+    glEnableVertexArrayAttrib(vao, a);
+  }
 }
 
 QueryRaster effective_query_raster(QueryRaster requested) {
@@ -373,6 +423,7 @@ Renderer::Renderer(const Scene& scene, const RendererOptions& options)
 Renderer::~Renderer() {
   Impl& g = *impl_;
   glFinish();  // nothing of ours may still be in flight when its objects go
+  g.destroy_device();
   if (!g.query_names.empty())
     glDeleteQueries(GLsizei(g.query_names.size()), g.query_names.data());
   if (g.timer) glDeleteQueries(1, &g.timer);
@@ -384,8 +435,9 @@ Renderer::~Renderer() {
   glDeleteProgram(g.scene_program);
   glDeleteProgram(g.query_program);
   glDeleteFramebuffers(1, &g.fbo);
-  const GLuint rbs[] = {g.color_rb, g.depth_rb, g.id_rb};
-  glDeleteRenderbuffers(3, rbs);
+  const GLuint rbs[] = {g.color_rb, g.id_rb};
+  glDeleteRenderbuffers(2, rbs);
+  glDeleteTextures(1, &g.depth_texture);
 }
 
 Renderer::Resources Renderer::resources() const {

@@ -53,13 +53,18 @@ std::uint64_t Renderer::samples_in_front(const View& view, std::span<const Objec
   return n;
 }
 
-std::vector<float> Renderer::read_depth() const {
+std::vector<float> Renderer::read_stored_depth() const {
   const Impl& g = *impl_;
   std::vector<float> depth(std::size_t(g.options.width) * std::size_t(g.options.height));
   bind_for_reading(g.fbo, 4);
   glReadPixels(0, 0, g.options.width, g.options.height, GL_DEPTH_COMPONENT, GL_FLOAT, depth.data());
   check_error("reading the depth buffer");
-  if (g.clip.reversed_z)  // canonical: 0 nearest, 1 farthest and nothing
+  return depth;
+}
+
+std::vector<float> Renderer::read_depth() const {
+  std::vector<float> depth = read_stored_depth();
+  if (impl_->clip.reversed_z)  // canonical: 0 nearest, 1 farthest and nothing
     for (float& d : depth) d = 1.0f - d;
   return depth;
 }

@@ -37,16 +37,22 @@ SceneMeshBuffers upload_scene_mesh(const SceneMesh& mesh) {
   glCreateBuffers(1, &b.index_buffer);
   glNamedBufferStorage(b.index_buffer, GLsizeiptr(std::max<std::size_t>(mesh.indices.size(), 1) * 4),
                        mesh.indices.empty() ? nullptr : mesh.indices.data(), 0);
-  glCreateVertexArrays(1, &b.vao);
-  glVertexArrayVertexBuffer(b.vao, 0, b.vertex_buffer, 0, 6 * sizeof(float));
-  glVertexArrayAttribFormat(b.vao, 0, 3, GL_FLOAT, GL_FALSE, 0);
-  glVertexArrayAttribFormat(b.vao, 1, 3, GL_FLOAT, GL_FALSE, 3 * sizeof(float));
-  glVertexArrayAttribBinding(b.vao, 0, 0);
-  glVertexArrayAttribBinding(b.vao, 1, 0);
-  glEnableVertexArrayAttrib(b.vao, 0);
-  glEnableVertexArrayAttrib(b.vao, 1);
-  glVertexArrayElementBuffer(b.vao, b.index_buffer);
+  b.vao = make_scene_vao(b.vertex_buffer, b.index_buffer);
   return b;
+}
+
+GLuint make_scene_vao(GLuint vertex_buffer, GLuint index_buffer) {
+  GLuint vao = 0;
+  glCreateVertexArrays(1, &vao);
+  glVertexArrayVertexBuffer(vao, 0, vertex_buffer, 0, 6 * sizeof(float));
+  glVertexArrayAttribFormat(vao, 0, 3, GL_FLOAT, GL_FALSE, 0);
+  glVertexArrayAttribFormat(vao, 1, 3, GL_FLOAT, GL_FALSE, 3 * sizeof(float));
+  glVertexArrayAttribBinding(vao, 0, 0);
+  glVertexArrayAttribBinding(vao, 1, 0);
+  glEnableVertexArrayAttrib(vao, 0);
+  glEnableVertexArrayAttrib(vao, 1);
+  glVertexArrayElementBuffer(vao, index_buffer);
+  return vao;
 }
 
 }  // namespace occull::gl

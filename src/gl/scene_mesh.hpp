@@ -31,5 +31,8 @@ struct SceneMeshBuffers {
   GLuint vertex_buffer = 0, index_buffer = 0, vao = 0;
 };
 [[nodiscard]] SceneMeshBuffers upload_scene_mesh(const SceneMesh& mesh);
+/// A vertex array over the buffers upload_scene_mesh() made: attribute 0
+/// the position, 1 the normal, the index buffer bound.
+[[nodiscard]] GLuint make_scene_vao(GLuint vertex_buffer, GLuint index_buffer);
 
 }  // namespace occull::gl

@@ -3,6 +3,7 @@
 #pragma once
 
 #include "occull/backend.hpp"
+#include "occull/device_culling.hpp"
 #include "occull/scene.hpp"
 #include "occull/view.hpp"
 
@@ -52,6 +53,11 @@ struct RendererOptions {
   /// Submit each material run of a render() call as one glMultiDrawElementsIndirect
   /// instead of one draw per object (same pixels; less driver overhead per object).
   bool multi_draw = false;
+  /// Device culling draws with glMultiDrawElementsIndirectCount over the
+  /// commands the device compacted, where the driver has it; off: always
+  /// the fallback (one command per object, glMultiDrawElementsIndirect),
+  /// to measure or test it.
+  bool device_draw_count = true;
   glm::vec3 background{0.62f, 0.74f, 0.86f};
   QueryRaster query_raster = QueryRaster::margin;
   /// The sub-pixel error query boxes absorb, in pixels. With `margin`, each
@@ -112,7 +118,7 @@ struct RendererOptions {
 /// frame: make a new renderer). Query calls check that the query is in
 /// flight (issued by this renderer, not yet read) and throw
 /// std::logic_error otherwise.
-class Renderer final : public Backend {
+class Renderer final : public Backend, public DeviceCulling {
  public:
   Renderer(const Scene& scene, const RendererOptions& options);
   ~Renderer() override;
@@ -135,6 +141,34 @@ class Renderer final : public Backend {
   [[nodiscard]] bool conditional_rendering() const override { return true; }
   void render_conditional(std::span<const ObjectId> objects, QueryId q, ConditionalWait wait) override;
   [[nodiscard]] BackendStats stats() const override { return stats_; }
+  [[nodiscard]] DeviceCulling* device_culling() override { return this; }
+
+  // DeviceCulling (occull/device_culling.hpp): compute shaders over a
+  // record per object (world box, draw command, material), a depth pyramid
+  // (R32F, built from the depth target by one dispatch per level, the rules
+  // of occull/depth_pyramid.hpp), and glMultiDrawElementsIndirectCount over
+  // commands the device compacts, where the driver has it
+  // (GL_ARB_indirect_parameters or GL 4.6); otherwise
+  // glMultiDrawElementsIndirect over one command per object, those not drawn
+  // with no instance. Made on first use (shaders compile then). Device
+  // draws count in stats() as render_flushes (one per indirect draw); the
+  // objects they drew are read back by read_drawn().
+  [[nodiscard]] Visibility create_visibility() override;
+  void destroy_visibility(Visibility v) override;
+  void draw_previously_visible(Visibility v) override;
+  void build_depth_pyramid() override;
+  void draw_newly_visible(Visibility v, int texels) override;
+  DeviceCullingTimes read_drawn(std::vector<ObjectId>& out) override;
+  /// Whether device draws are compacted (drawn with a count the device
+  /// wrote) rather than one command per object. Precondition: a
+  /// DeviceCulling call was made.
+  [[nodiscard]] bool device_draws_compacted() const;
+  /// For tests: level `level` (>= 1) of the last build_depth_pyramid(),
+  /// row-major, bottom row first, as stored (device depth). Waits for the device.
+  [[nodiscard]] std::vector<float> read_depth_pyramid(int level) const;
+  /// The device's depth target as stored (with reversed-Z, larger is
+  /// nearer), unlike read_depth(): level 0 of the pyramid.
+  [[nodiscard]] std::vector<float> read_stored_depth() const;
 
   /// The result of query `q` without ending its flight: the culler that
   /// issued it still reads it with result(). Waits for the device if the
