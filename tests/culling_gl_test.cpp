@@ -21,7 +21,8 @@ constexpr int kFrames = 10;
 const char* const kConservative[] = {
     "stopwait", "chc", "chc:skip=4", "chcpp", "chcpp:batch=1", "chcpp:vqueue=off",
     "chcpp:multiquery=off", "chcpp:jitter=off", "chcpp:tight=off", "chcpp:virtual_leaf=0", "nohc",
-    "auto:trial=1:period=2"};  // auto switching every few frames: each candidate returns to stale state
+    "auto:trial=1:period=2",  // auto switching every few frames: each candidate returns to stale state
+    "hiz", "hiz:texels=2", "hiz:texels=8"};
 
 gl::RendererOptions small_target() { return test::small_target(192, 108); }
 
@@ -149,5 +150,6 @@ TEST(ConservativeCullers, EngineMovedObjectsAreFollowedWithoutMisses) {
     session.release(*culler);
     return missed;
   };
-  for (const char* spec : {"vfc", "chc", "chcpp", "nohc", "stopwait", "auto"}) EXPECT_EQ(truth_and_run(spec), 0u) << spec;
+  for (const char* spec : {"vfc", "chc", "chcpp", "nohc", "stopwait", "auto", "hiz"})
+    EXPECT_EQ(truth_and_run(spec), 0u) << spec;
 }

@@ -89,6 +89,18 @@ TEST(DepthPyramid, LevelOneTooFineMissesAGap) {
   expect_only_the_rule_sees_the_gap(image, 16, 1, over_pixels(3, 8, 0, 0, 0.7f, 0.8f), broken);
 }
 
+TEST(DepthPyramid, MoreTexelsAtAFinerLevelTestTighter) {
+  // Pixels 3..8 in front of a wall that ends at pixel 12: two texels of
+  // level 3 reach the gap beyond it, three of level 2 do not.
+  std::vector<float> image = wall(16, 1, 0.5f);
+  for (int x = 12; x < 16; ++x) image[std::size_t(x)] = 1.0f;
+  const DepthPyramid pyramid(image, 16, 1, false);
+  const Aabb box = over_pixels(3, 8, 0, 0, 0.7f, 0.8f);
+  EXPECT_FALSE(pyramid.occluded(box, pixel_view(16, 1), kZeroToOne, 2));
+  EXPECT_TRUE(pyramid.occluded(box, pixel_view(16, 1), kZeroToOne, 4));
+  EXPECT_TRUE(pyramid.occluded(box, pixel_view(16, 1), kZeroToOne, 8));
+}
+
 TEST(DepthPyramid, DepthAtTheNearestCorner) {
   // A box from in front of the wall to behind it: its front shows.
   PyramidRules broken;
@@ -135,9 +147,9 @@ TEST(DepthPyramid, BoxesReachingTheEyeAreVisible) {
   EXPECT_TRUE(DepthPyramid(image, w, h, false).occluded({{-0.3f, -0.3f, -5.0f}, {0.3f, 0.3f, -3.0f}}, proj, clip));
 }
 
-// Whatever the image and box: the pyramid hides a box only if every pixel
-// its rectangle touches is nearer than its nearest corner (a brute force
-// over level 0), and it never hides one the brute force sees.
+// Whatever the image, box and texels read: the pyramid hides a box only if
+// every pixel its rectangle touches is nearer than its nearest corner (a
+// brute force over level 0).
 TEST(DepthPyramid, HidesOnlyWhatEveryTouchedPixelHides) {
   std::mt19937 rng(7);
   std::uniform_real_distribution<float> unit(0.0f, 1.0f);
@@ -153,7 +165,8 @@ TEST(DepthPyramid, HidesOnlyWhatEveryTouchedPixelHides) {
       const float x0 = unit(rng) * float(w), y0 = unit(rng) * float(h);
       const float near = unit(rng);
       const Aabb box{{x0, y0, -(near + 0.1f)}, {x0 + unit(rng) * float(w) / 2, y0 + unit(rng) * float(h) / 2, -near}};
-      if (!pyramid.occluded(box, vp, kZeroToOne)) continue;
+      const int texels = 2 << (k % 3);  // 2, 4, 8
+      if (!pyramid.occluded(box, vp, kZeroToOne, texels)) continue;
       ++hidden;
       for (int y = std::max(0, int(std::floor(box.min.y))); y <= std::min(h - 1, int(std::floor(box.max.y))); ++y)
         for (int x = std::max(0, int(std::floor(box.min.x))); x <= std::min(w - 1, int(std::floor(box.max.x))); ++x)

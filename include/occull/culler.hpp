@@ -188,6 +188,10 @@ struct AlgorithmInfo {
   /// Its cullers of the views of one frame share state (`grid`: one grid
   /// and one query cap), so make_split_screen() makes them together.
   bool shares_views = false;
+  /// Culls on the device (`hiz`): its backend must offer DeviceCulling
+  /// (Backend::device_culling()), and render_frame() throws InputError on
+  /// one that does not.
+  bool device = false;
 };
 
 /// Every algorithm make_culler() knows, in presentation order.

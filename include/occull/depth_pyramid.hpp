@@ -23,7 +23,9 @@
 //     at level 0, spans at most 2×2 texels: L = ceil(log2(max(w, h))), since
 //     w <= 2^L texels lie in at most two blocks of 2^L. All (up to four)
 //     texels at L are read. floor(log2) instead, or one level finer
-//     (a level "bias" of -1), leaves up to 3 blocks to 2 reads.
+//     (a level "bias" of -1), leaves up to 3 blocks to 2 reads. A test
+//     reading up to T × T texels (T = 4 or 8) goes log2(T/2) levels finer,
+//     where w <= (T/2)·2^L texels lie in at most T blocks, and reads them all.
 //                                  (LevelIsTheCeilingOfLog2, LevelOneTooFineMissesAGap)
 //  5. Depth at the box's nearest point: the nearest of its 8 corners (depth
 //     is monotonic in the distance along the view axis, which is linear over
@@ -96,8 +98,12 @@ class DepthPyramid {
 
   /// Whether `box` (world space) is hidden behind the depth of the image as
   /// seen through `view_proj` with clip conventions `clip` (its reversed_z
-  /// must be the pyramid's). False means "may be visible".
-  [[nodiscard]] bool occluded(const Aabb& box, const glm::mat4& view_proj, const ClipSpace& clip) const;
+  /// must be the pyramid's). False means "may be visible". The test reads
+  /// at most `texels` × `texels` texels (2, 4 or 8), at the level where the
+  /// box's rectangle spans that many: log2(texels / 2) levels finer than
+  /// rule 4's, a tighter test for more reads.
+  [[nodiscard]] bool occluded(const Aabb& box, const glm::mat4& view_proj, const ClipSpace& clip,
+                              int texels = 2) const;
 
  private:
   struct Level {

@@ -50,7 +50,8 @@ float DepthPyramid::at(int level, int x, int y) const {
   return l.texels.at(std::size_t(y) * std::size_t(l.width) + std::size_t(x));
 }
 
-bool DepthPyramid::occluded(const Aabb& box, const glm::mat4& view_proj, const ClipSpace& clip) const {
+bool DepthPyramid::occluded(const Aabb& box, const glm::mat4& view_proj, const ClipSpace& clip, int texels) const {
+  assert(texels == 2 || texels == 4 || texels == 8);
   if (box.empty()) return true;  // nothing to draw
   const Level& base = levels_.front();
   constexpr float inf = std::numeric_limits<float>::infinity();
@@ -85,22 +86,27 @@ bool DepthPyramid::occluded(const Aabb& box, const glm::mat4& view_proj, const C
   }
   // Rule 3: every pixel the rectangle touches, widened for rounding.
   constexpr float margin = 1.0f / 64.0f;
-  const int x0 = std::max(0, int(std::floor(min_x - margin)));
-  const int y0 = std::max(0, int(std::floor(min_y - margin)));
-  const int x1 = std::min(base.width - 1, int(std::floor(max_x + margin)));
-  const int y1 = std::min(base.height - 1, int(std::floor(max_y + margin)));
+  // (Clamped as floats first: a corner just in front of the eye projects
+  // far off the image, past what an int holds.)
+  const auto pixel = [](float v, int size) { return int(std::clamp(std::floor(v), -1.0f, float(size))); };
+  const int x0 = std::max(0, pixel(min_x - margin, base.width));
+  const int y0 = std::max(0, pixel(min_y - margin, base.height));
+  const int x1 = std::min(base.width - 1, pixel(max_x + margin, base.width));
+  const int y1 = std::min(base.height - 1, pixel(max_y + margin, base.height));
   if (x0 > x1 || y0 > y1) return true;  // off the image: nothing to draw
-  // Rule 4: the level where the rectangle spans at most 2×2 texels.
+  // Rule 4: the level where the rectangle spans at most texels × texels.
   const int extent = std::max(x1 - x0 + 1, y1 - y0 + 1);
   int level = rules_.ceil_level ? pyramid_level_for(extent) : std::bit_width(unsigned(extent)) - 1;
+  level -= std::bit_width(unsigned(texels)) - 2;  // log2(texels / 2) levels finer
   level = std::clamp(level + rules_.level_bias, 0, levels() - 1);
   const Level& l = levels_[std::size_t(level)];
-  // Two texels from the rectangle's first along each axis (all of them at
-  // the right level), within the level.
+  // The rectangle's texels at that level, at most `texels` from its first
+  // along each axis (all of them at the right level).
   const int tx = x0 >> level, ty = y0 >> level;
+  const int tx1 = std::min(x1 >> level, tx + texels - 1), ty1 = std::min(y1 >> level, ty + texels - 1);
   float farthest = -inf;
-  for (int y = ty; y <= std::min(ty + 1, l.height - 1); ++y)
-    for (int x = tx; x <= std::min(tx + 1, l.width - 1); ++x)
+  for (int y = ty; y <= ty1; ++y)
+    for (int x = tx; x <= tx1; ++x)
       farthest = std::max(farthest, key(l.texels[std::size_t(y) * std::size_t(l.width) + std::size_t(x)]));
   // Rule 7: ties and depth rounding are visible.
   const float tolerance = rules_.depth_margin ? depth_tolerance(farthest) : 0.0f;

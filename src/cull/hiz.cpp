@@ -73,7 +73,8 @@ Registration hiz_registration() {
   return registered({"hiz",
                      "GPU-driven two-phase depth-pyramid culling: the device draws last frame's visible, builds a "
                      "depth pyramid, tests every object against it and draws the newly visible (needs a backend "
-                     "with device culling)"},
+                     "with device culling)",
+                     true, {}, false, SceneKind::bvh, false, true},
                     table, [](const SceneIndex&, const HizConfig& config, const Options&, const CullerContext&) {
                       return std::make_unique<HizCuller>(config);
                     });
