@@ -1,0 +1,244 @@
+// GL integration: `hiz` and the renderer's DeviceCulling on llvmpipe, small
+// frames. Every scene kind through the verifier is in culling_gl_test.cpp
+// and adversarial_test.cpp (hiz is among their conservative cullers).
+#include "gl/gl.hpp"
+#include "occull/culler.hpp"
+#include "occull/depth_pyramid.hpp"
+#include "occull/error.hpp"
+#include "occull/gl/context.hpp"
+#include "occull/gl/renderer.hpp"
+#include "occull/recording_backend.hpp"
+#include "occull/scenes.hpp"
+#include "test_util.hpp"
+
+#include <glm/gtc/matrix_transform.hpp>
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <memory>
+#include <set>
+
+using namespace occull;
+
+namespace {
+
+constexpr int kSize = 96;
+
+class Hiz : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() { context_ = gl::Context::create(); }
+  static void TearDownTestSuite() { context_.reset(); }
+  static std::unique_ptr<gl::Context> context_;
+
+  static gl::RendererOptions target(int width = kSize, int height = kSize) {
+    gl::RendererOptions o;
+    o.width = width;
+    o.height = height;
+    return o;
+  }
+};
+std::unique_ptr<gl::Context> Hiz::context_;
+
+// Camera at the origin looking down -Z; a 6 x 6 wall 10 m ahead hides a box
+// 20 m ahead; another box 20 m ahead and 8 m right is in plain view.
+struct WallScene {
+  static constexpr ObjectId wall = 0, hidden = 1, beside = 2;
+  Scene scene = test::box_scene({{{-3, -3, -11}, {3, 3, -10}}, {{-1, -1, -21}, {1, 1, -19}}, {{7, -1, -21}, {9, 1, -19}}});
+  Bvh bvh = Bvh::build(scene);
+  View view = make_view({{0, 0, 0}, 0, 0}, {60.0f, 0.1f, 100.0f}, kSize, kSize);
+};
+
+// One frame of `culler` through a RecordingBackend over `r`: what the device
+// drew, ascending, as the harness reads it back.
+std::vector<ObjectId> frame(Culler& culler, gl::Renderer& r, const Scene& scene, const View& view) {
+  RecordingBackend recorder(r, scene);
+  r.begin_frame(view);
+  recorder.start_frame();
+  culler.render_frame(view, recorder);
+  r.end_frame();
+  recorder.finish_frame([&](QueryId q) { return r.unread_result(q); });
+  std::vector<ObjectId> drawn(recorder.objects().begin(), recorder.objects().end());
+  return drawn;
+}
+
+std::set<ObjectId> ids_in(const std::vector<std::uint32_t>& pixels) {
+  std::set<ObjectId> ids;
+  for (std::uint32_t p : pixels)
+    if (p != 0) ids.insert(p - 1);
+  return ids;
+}
+
+}  // namespace
+
+TEST_F(Hiz, ABoxBehindAWallIsNotDrawnOnceItsDepthIsKnown) {
+  WallScene w;
+  gl::Renderer r(w.scene, target());
+  auto hiz = make_culler("hiz", {w.scene, w.bvh});
+  // Frame 1: nothing visible yet, an empty pyramid: all three drawn.
+  EXPECT_EQ(frame(*hiz, r, w.scene, w.view), (std::vector<ObjectId>{0, 1, 2}));
+  // Frame 2: phase 1 draws all three; phase 2 finds the hidden box behind the wall.
+  (void)frame(*hiz, r, w.scene, w.view);
+  // Frame 3: it is not drawn in phase 1, and phase 2 finds it hidden again.
+  EXPECT_EQ(frame(*hiz, r, w.scene, w.view), (std::vector<ObjectId>{WallScene::wall, WallScene::beside}));
+  EXPECT_EQ(ids_in(r.read_ids()), (std::set<ObjectId>{WallScene::wall, WallScene::beside}));
+  hiz->release(r);
+}
+
+TEST_F(Hiz, AnObjectUncoveredByAMovingOccluderIsDrawnInTheSameFrame) {
+  WallScene w;
+  gl::Renderer r(w.scene, target());
+  auto hiz = make_culler("hiz", {w.scene, w.bvh});
+  for (int f = 0; f < 3; ++f) (void)frame(*hiz, r, w.scene, w.view);
+  ASSERT_EQ(frame(*hiz, r, w.scene, w.view), (std::vector<ObjectId>{WallScene::wall, WallScene::beside}));
+  // The wall slides 20 m left between frames: the box behind it shows now.
+  w.scene.set_transform(WallScene::wall, glm::translate(glm::mat4(1.0f), glm::vec3(-20.0f, 0.0f, 0.0f)));
+  w.bvh.refit(w.scene);
+  const std::vector<ObjectId> drawn = frame(*hiz, r, w.scene, w.view);
+  EXPECT_TRUE(std::binary_search(drawn.begin(), drawn.end(), WallScene::hidden));
+  EXPECT_TRUE(ids_in(r.read_ids()).count(WallScene::hidden));
+  hiz->release(r);
+}
+
+// Each object drawn once: the triangles the device made (a primitives
+// query around the frame's device draws) are exactly those of the objects
+// read back, each counted once; and every object in the id image was read
+// back as drawn.
+TEST_F(Hiz, TheReadBackIsExactlyWhatTheDeviceDrewEachOnce) {
+  Scene scene = test::box_scene({{{-3, -3, -11}, {3, 3, -10}}, {{-1, -1, -21}, {1, 1, -19}},
+                                 {{7, -1, -21}, {9, 1, -19}}, {{-9, -1, -31}, {-7, 1, -29}},
+                                 {{2, 2, -41}, {4, 4, -39}}, {{-2, -8, -15}, {2, -6, -14}}});
+  const Bvh bvh = Bvh::build(scene);
+  gl::Renderer r(scene, target());
+  auto hiz = make_culler("hiz", {scene, bvh});
+  GLuint primitives = 0;
+  glCreateQueries(GL_PRIMITIVES_GENERATED, 1, &primitives);
+  for (int f = 0; f < 6; ++f) {
+    // The camera turns a little each frame, so phase 2 finds new objects.
+    const View view = make_view({{0, 0, 0}, 0.08f * float(f), 0}, {60.0f, 0.1f, 100.0f}, kSize, kSize);
+    RecordingBackend recorder(r, scene);
+    r.begin_frame(view);
+    recorder.start_frame();
+    glBeginQuery(GL_PRIMITIVES_GENERATED, primitives);
+    hiz->render_frame(view, recorder);
+    glEndQuery(GL_PRIMITIVES_GENERATED);
+    r.end_frame();
+    recorder.finish_frame([&](QueryId q) { return r.unread_result(q); });
+    GLuint64 made = 0;
+    glGetQueryObjectui64v(primitives, GL_QUERY_RESULT, &made);
+    std::uint64_t expected = 0;
+    const std::set<ObjectId> drawn(recorder.objects().begin(), recorder.objects().end());
+    EXPECT_EQ(drawn.size(), recorder.objects().size()) << "an object read back twice, frame " << f;
+    for (ObjectId id : drawn) expected += scene.object(id).triangles;
+    EXPECT_EQ(made, expected) << "frame " << f;
+    for (ObjectId id : ids_in(r.read_ids())) EXPECT_TRUE(drawn.count(id)) << id << " shown, not read back, frame " << f;
+    EXPECT_EQ(recorder.stats().objects_rendered, drawn.size());
+  }
+  glDeleteQueries(1, &primitives);
+  hiz->release(r);
+}
+
+TEST_F(Hiz, CompactedAndPerObjectCommandsDrawTheSame) {
+  Scene city = make_scene("city:blocks=3,traffic=10").scene;
+  const Bvh bvh = Bvh::build(city);
+  gl::RendererOptions compacted = target(160, 90), per_object = target(160, 90);
+  per_object.device_draw_count = false;
+  gl::Renderer a(city, compacted), b(city, per_object);
+  auto ha = make_culler("hiz", {city, bvh});
+  auto hb = make_culler("hiz", {city, bvh});
+  const View view = make_view({{0, 1.7f, 0}, 0.3f, 0}, {70.0f, 0.1f, 500.0f}, 160, 90);
+  for (int f = 0; f < 3; ++f) {
+    EXPECT_EQ(frame(*ha, a, city, view), frame(*hb, b, city, view)) << "frame " << f;
+    EXPECT_EQ(a.read_ids(), b.read_ids()) << "frame " << f;
+  }
+  EXPECT_FALSE(b.device_draws_compacted());
+  ha->release(a);
+  hb->release(b);
+}
+
+// The device's pyramid is the reference's (occull/depth_pyramid.hpp, whose
+// rules the unit tests break one by one) bit for bit, built from the same
+// depth, with an odd-sized target, in both depth conventions.
+TEST_F(Hiz, TheDevicesPyramidIsTheReferenceBuiltFromTheSameDepth) {
+  Scene city = make_scene("city:blocks=3,traffic=10").scene;
+  const Bvh bvh = Bvh::build(city);
+  for (const DepthMode depth : {DepthMode::standard, DepthMode::reversed}) {
+    gl::Renderer r(city, target(157, 91));
+    auto hiz = make_culler("hiz", {city, bvh});
+    Lens lens{70.0f, 0.1f, 500.0f};
+    lens.depth = depth;
+    const View view = make_view({{0, 1.7f, 0}, 0.3f, 0}, lens, 157, 91);
+    for (int f = 0; f < 2; ++f) (void)frame(*hiz, r, city, view);
+    // The last frame drew nothing new in phase 2 (the view did not move), so
+    // the final depth is the one its pyramid was built from.
+    const std::vector<float> stored = r.read_stored_depth();
+    const auto [nearest, farthest] = std::minmax_element(stored.begin(), stored.end());
+    ASSERT_LT(*nearest, *farthest) << "the view should see something in front of the background";
+    const DepthPyramid reference(stored, 157, 91, view.clip.reversed_z);
+    for (int level = 1; level < reference.levels(); ++level) {
+      const std::vector<float> device = r.read_depth_pyramid(level);
+      const auto expected = reference.level(level);
+      ASSERT_EQ(device.size(), expected.size()) << "level " << level;
+      EXPECT_TRUE(std::equal(device.begin(), device.end(), expected.begin()))
+          << "level " << level << (depth == DepthMode::reversed ? " reversed" : "");
+    }
+    hiz->release(r);
+  }
+}
+
+TEST_F(Hiz, FollowsObjectsRemovedAndAddedBack) {
+  WallScene w;
+  gl::Renderer r(w.scene, target());
+  auto hiz = make_culler("hiz", {w.scene, w.bvh});
+  for (int f = 0; f < 2; ++f) (void)frame(*hiz, r, w.scene, w.view);
+  w.scene.remove_object(WallScene::beside);
+  w.bvh.refit(w.scene);
+  EXPECT_EQ(frame(*hiz, r, w.scene, w.view), (std::vector<ObjectId>{WallScene::wall}));
+  // The slot comes back as a box in front of the wall.
+  const MeshId mesh = w.scene.add_mesh(test::box_mesh({{-0.5f, -0.5f, -6}, {0.5f, 0.5f, -5}}));
+  ASSERT_EQ(w.scene.add_object(mesh, 0, glm::mat4(1.0f), OccluderClass::always), WallScene::beside);
+  w.bvh.refit(w.scene);
+  EXPECT_EQ(frame(*hiz, r, w.scene, w.view), (std::vector<ObjectId>{WallScene::wall, WallScene::beside}));
+  hiz->release(r);
+}
+
+TEST_F(Hiz, AnEmptySceneAndObjectsWithoutTrianglesDrawNothing) {
+  Scene empty("empty");
+  const Bvh none = Bvh::build(empty);
+  gl::Renderer r(empty, target());
+  auto hiz = make_culler("hiz", {empty, none});
+  const View view = make_view({{0, 0, 0}, 0, 0}, {60.0f, 0.1f, 100.0f}, kSize, kSize);
+  for (int f = 0; f < 2; ++f) EXPECT_TRUE(frame(*hiz, r, empty, view).empty());
+  hiz->release(r);
+
+  WallScene w;
+  w.scene.remove_object(WallScene::hidden);  // empty bounds, no triangles
+  w.bvh.refit(w.scene);
+  gl::Renderer r2(w.scene, target());
+  auto hiz2 = make_culler("hiz", {w.scene, w.bvh});
+  for (int f = 0; f < 2; ++f)
+    EXPECT_EQ(frame(*hiz2, r2, w.scene, w.view), (std::vector<ObjectId>{WallScene::wall, WallScene::beside}));
+  hiz2->release(r2);
+}
+
+TEST_F(Hiz, AVisibilityHandedBackCannotBeUsedAgain) {
+  WallScene w;
+  gl::Renderer r(w.scene, target());
+  const DeviceCulling::Visibility v = r.create_visibility();
+  r.destroy_visibility(v);
+  r.begin_frame(w.view);
+  EXPECT_THROW(r.draw_previously_visible(v), std::logic_error);
+  EXPECT_THROW(r.draw_newly_visible(v, 4), std::logic_error);
+  r.end_frame();
+  EXPECT_THROW(r.destroy_visibility(v), std::logic_error);
+}
+
+TEST_F(Hiz, PhaseTwoWithoutAPyramidIsRefused) {
+  WallScene w;
+  gl::Renderer r(w.scene, target());
+  const DeviceCulling::Visibility v = r.create_visibility();
+  r.begin_frame(w.view);
+  r.draw_previously_visible(v);
+  EXPECT_THROW(r.draw_newly_visible(v, 4), std::logic_error);
+  r.end_frame();
+  r.destroy_visibility(v);
+}
