@@ -16,7 +16,7 @@ namespace {
 
 constexpr int kFrames = 24;
 const char* const kCullers[] = {"stopwait", "chc",  "chcpp", "chcpp:virtual_leaf=0", "nohc", "auto:trial=1:period=2",
-                                "hiz",      "hiz:texels=8"};
+                                "hiz",      "hiz:texels=2"};
 
 Options fixed_profile() {
   Options o;

@@ -22,7 +22,7 @@ const char* const kConservative[] = {
     "stopwait", "chc", "chc:skip=4", "chcpp", "chcpp:batch=1", "chcpp:vqueue=off",
     "chcpp:multiquery=off", "chcpp:jitter=off", "chcpp:tight=off", "chcpp:virtual_leaf=0", "nohc",
     "auto:trial=1:period=2",  // auto switching every few frames: each candidate returns to stale state
-    "hiz", "hiz:texels=2", "hiz:texels=8"};
+    "hiz", "hiz:texels=2", "hiz:texels=16"};
 
 gl::RendererOptions small_target() { return test::small_target(192, 108); }
 

@@ -165,7 +165,7 @@ TEST(DepthPyramid, HidesOnlyWhatEveryTouchedPixelHides) {
       const float x0 = unit(rng) * float(w), y0 = unit(rng) * float(h);
       const float near = unit(rng);
       const Aabb box{{x0, y0, -(near + 0.1f)}, {x0 + unit(rng) * float(w) / 2, y0 + unit(rng) * float(h) / 2, -near}};
-      const int texels = 2 << (k % 3);  // 2, 4, 8
+      const int texels = 2 << (k % 4);  // 2, 4, 8, 16
       if (!pyramid.occluded(box, vp, kZeroToOne, texels)) continue;
       ++hidden;
       for (int y = std::max(0, int(std::floor(box.min.y))); y <= std::min(h - 1, int(std::floor(box.max.y))); ++y)

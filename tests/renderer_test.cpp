@@ -318,7 +318,7 @@ TEST_F(RendererTest, DynamicObjectsAreDrawnWhereTheyAreNow) {
   const View view = make_view({{0, 0, 0}, 0, 0}, {60.0f, 0.1f, 100.0f}, kSize, kSize);
   for (const bool multi : {false, true}) {  // matrices as uniforms, and from the object buffer
     gl::RendererOptions o = small();
-    o.multi_draw = multi;
+    o.draw = multi ? gl::DrawMode::multi : gl::DrawMode::single;
     gl::Renderer r(scene, o);
     const ObjectId obj[] = {0};
     scene.update(0.0);  // far left: outside the view
@@ -361,7 +361,7 @@ TEST_F(RendererTest, GpuTimeOfAFrameThatDrawsIsPositiveWhereTheDeviceHasATimer) 
   }
 }
 
-TEST_F(RendererTest, MultiDrawGivesTheSamePixelsAsSingleDraws) {
+TEST_F(RendererTest, EveryDrawModeGivesTheSamePixels) {
   // Four boxes, then a row of 20 more: runs of one material both shorter and
   // longer than the renderer's shortest multi-draw (kMinMultiDrawRun, 16).
   std::vector<Aabb> boxes = {{{-3, -3, -11}, {3, 3, -10}},
@@ -372,12 +372,12 @@ TEST_F(RendererTest, MultiDrawGivesTheSamePixelsAsSingleDraws) {
     boxes.push_back({{-10.0f + float(i), 14.0f, -40.0f}, {-9.5f + float(i), 14.5f, -39.0f}});
   Scene scene = test::box_scene(boxes);
   const View view = make_view({{0, 0, 0}, 0, 0}, {60.0f, 0.1f, 100.0f}, kSize, kSize);
-  std::vector<std::uint32_t> images[2];
-  std::vector<std::uint8_t> colours[2];
-  std::vector<float> depths[2];
-  for (int multi = 0; multi < 2; ++multi) {
+  std::vector<std::uint32_t> images[3];
+  std::vector<std::uint8_t> colours[3];
+  std::vector<float> depths[3];
+  for (int multi = 0; multi < 3; ++multi) {  // single, multi, indirect
     gl::RendererOptions o = small();
-    o.multi_draw = multi == 1;
+    o.draw = gl::DrawMode(multi);
     gl::Renderer r(scene, o);
     std::vector<ObjectId> row;
     for (ObjectId id = 4; id < 24; ++id) row.push_back(id);
@@ -393,11 +393,14 @@ TEST_F(RendererTest, MultiDrawGivesTheSamePixelsAsSingleDraws) {
     depths[multi] = r.read_depth();
     EXPECT_EQ(r.stats().draw_calls, 48u);
   }
-  // The two programs fetch per-draw data differently (uniforms / object
-  // buffer): the ids, colours and depths must not differ by a bit.
-  EXPECT_EQ(images[0], images[1]);
-  EXPECT_EQ(colours[0], colours[1]);
-  EXPECT_EQ(depths[0], depths[1]);
+  // The three programs fetch per-draw data differently (uniforms / object
+  // buffer / instanced attributes): the ids, colours and depths must not
+  // differ by a bit.
+  for (int mode : {1, 2}) {
+    EXPECT_EQ(images[0], images[mode]) << "mode " << mode;
+    EXPECT_EQ(colours[0], colours[mode]) << "mode " << mode;
+    EXPECT_EQ(depths[0], depths[mode]) << "mode " << mode;
+  }
   std::set<ObjectId> expected{0, 2, 3};
   for (ObjectId id = 4; id < 24; ++id) expected.insert(id);
   EXPECT_EQ(ids_in(images[1]), expected);
@@ -453,7 +456,7 @@ TEST_F(RendererTest, AnotherRendererInTheSameContextChangesNothing) {
     o.height = 32;
     o.query_mode = gl::QueryMode::any_samples_passed;
     o.cull_backfaces = false;
-    o.multi_draw = true;
+    o.draw = gl::DrawMode::multi;
     gl::Renderer b(other, o);
     const View v = make_view({{0, 0, 0}, 0.3f, 0.1f}, {90.0f, 0.5f, 50.0f}, 48, 32);
     b.begin_frame(v);

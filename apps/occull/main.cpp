@@ -249,10 +249,11 @@ bool parse_on_off(const std::string& flag, const std::string& s) {
   throw occull::InputError(fmt::format("{} '{}': expected on or off", flag, s));
 }
 
-bool parse_draw_mode(const std::string& s) {
-  if (s == "single") return false;
-  if (s == "multi") return true;
-  throw occull::InputError(fmt::format("unknown draw mode '{}'; valid modes: single, multi", s));
+occull::gl::DrawMode parse_draw_mode(const std::string& s) {
+  if (s == "single") return occull::gl::DrawMode::single;
+  if (s == "multi") return occull::gl::DrawMode::multi;
+  if (s == "indirect") return occull::gl::DrawMode::indirect;
+  throw occull::InputError(fmt::format("unknown draw mode '{}'; valid modes: single, multi, indirect", s));
 }
 
 occull::Options parse_options(const std::vector<std::string>& opts) {
@@ -349,7 +350,7 @@ occull::BenchConfig bench_config(const BenchArgs& a) {
   c.query_mode = parse_query_mode(a.query_mode);
   c.query_raster = parse_query_raster(a.query_raster);
   c.query_margin_px = a.query_margin;
-  c.multi_draw = parse_draw_mode(a.draw);
+  c.draw = parse_draw_mode(a.draw);
   c.depth = occull::parse_depth_mode(a.depth);
   c.engine_moves = a.engine_moves;
   c.gl_debug = a.gl_debug;
@@ -959,7 +960,7 @@ int main(int argc, char** argv) {
                 "default: the scene's paths in turn); grid shares one grid and query cap between them")
       ->capture_default_str();
   b->add_option("--draw", bench.draw,
-                "object submission: single (one draw per object) or multi (one multi-draw per material run)")
+                "object submission: single (one draw per object), multi (one multi-draw per material run) or indirect (one multi-draw per render call over all materials: the draw path of hiz, commands written by the CPU)")
       ->capture_default_str();
   b->add_option("--depth", bench.depth, kDepthHelp)->capture_default_str();
   b->add_option("--engine-moves", bench.engine_moves,

@@ -33,7 +33,7 @@ struct BenchConfig {
   gl::QueryMode query_mode = gl::QueryMode::samples_passed;
   gl::QueryRaster query_raster = gl::QueryRaster::margin;  ///< see gl::RendererOptions
   float query_margin_px = gl::RendererOptions{}.query_margin_px;
-  bool multi_draw = false;                ///< see gl::RendererOptions::multi_draw
+  gl::DrawMode draw = gl::DrawMode::single;  ///< see gl::RendererOptions::draw
   DepthMode depth = DepthMode::standard;  ///< the views' depth convention (Session::set_depth)
   double engine_moves = 0.0;              ///< fraction of static objects the engine moves each frame (Session::set_engine_moves)
   BvhOptions bvh;                         ///< how the scene's hierarchy is built

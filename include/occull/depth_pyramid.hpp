@@ -24,7 +24,7 @@
 //     w <= 2^L texels lie in at most two blocks of 2^L. All (up to four)
 //     texels at L are read. floor(log2) instead, or one level finer
 //     (a level "bias" of -1), leaves up to 3 blocks to 2 reads. A test
-//     reading up to T × T texels (T = 4 or 8) goes log2(T/2) levels finer,
+//     reading up to T × T texels (T = 4, 8 or 16) goes log2(T/2) levels finer,
 //     where w <= (T/2)·2^L texels lie in at most T blocks, and reads them all.
 //                                  (LevelIsTheCeilingOfLog2, LevelOneTooFineMissesAGap)
 //  5. Depth at the box's nearest point: the nearest of its 8 corners (depth
@@ -99,7 +99,7 @@ class DepthPyramid {
   /// Whether `box` (world space) is hidden behind the depth of the image as
   /// seen through `view_proj` with clip conventions `clip` (its reversed_z
   /// must be the pyramid's). False means "may be visible". The test reads
-  /// at most `texels` × `texels` texels (2, 4 or 8), at the level where the
+  /// at most `texels` × `texels` texels (2, 4, 8 or 16), at the level where the
   /// box's rectangle spans that many: log2(texels / 2) levels finer than
   /// rule 4's, a tighter test for more reads.
   [[nodiscard]] bool occluded(const Aabb& box, const glm::mat4& view_proj, const ClipSpace& clip,

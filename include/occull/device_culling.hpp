@@ -69,10 +69,10 @@ class DeviceCulling {
   /// Phase 2: tests every object in the frustum against the pyramid, sets
   /// its bit in `v` to the outcome (visible or not), and draws those visible
   /// and not drawn yet this frame. Each test reads at most `texels` × `texels`
-  /// texels (2, 4 or 8; occull/depth_pyramid.hpp, rule 4): more reads at a
+  /// texels (2, 4, 8 or 16; occull/depth_pyramid.hpp, rule 4): more reads at a
   /// finer level, a tighter test. Preconditions: build_depth_pyramid() ran
-  /// in this frame, after the last draw that should occlude; texels is 2, 4
-  /// or 8.
+  /// in this frame, after the last draw that should occlude; texels is 2, 4,
+  /// 8 or 16.
   virtual void draw_newly_visible(Visibility v, int texels) = 0;
 
   /// For instruments, after the frame: appends the objects the device drew

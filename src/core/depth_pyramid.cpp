@@ -51,7 +51,7 @@ float DepthPyramid::at(int level, int x, int y) const {
 }
 
 bool DepthPyramid::occluded(const Aabb& box, const glm::mat4& view_proj, const ClipSpace& clip, int texels) const {
-  assert(texels == 2 || texels == 4 || texels == 8);
+  assert(texels == 2 || texels == 4 || texels == 8 || texels == 16);
   if (box.empty()) return true;  // nothing to draw
   const Level& base = levels_.front();
   constexpr float inf = std::numeric_limits<float>::infinity();

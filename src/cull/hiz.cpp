@@ -27,7 +27,7 @@ namespace occull::detail {
 namespace {
 
 struct HizConfig {
-  int texels = 4;
+  int texels = 8;
 };
 
 class HizCuller final : public Culler {
@@ -67,7 +67,7 @@ class HizCuller final : public Culler {
 
 Registration hiz_registration() {
   static const ConfigTable<HizConfig> table = ConfigTable<HizConfig>().choice(
-      "texels", &HizConfig::texels, {{"2", 2}, {"4", 4}, {"8", 8}},
+      "texels", &HizConfig::texels, {{"2", 2}, {"4", 4}, {"8", 8}, {"16", 16}},
       "texels per axis each pyramid test reads at most: a box is tested at the level where its screen rectangle "
       "spans that many (more reads at a finer level: a tighter test)");
   return registered({"hiz",

@@ -221,7 +221,7 @@ BenchResult run_bench(const BenchConfig& config, const ProgressFn& progress) {
   ropts.height = config.height;
   ropts.query_mode = config.query_mode;
   ropts.write_ids = false;  // timed frames draw colour and depth only
-  ropts.multi_draw = config.multi_draw;
+  ropts.draw = config.draw;
   ropts.query_raster = config.query_raster;
   ropts.query_margin_px = config.query_margin_px;
   if (!(config.query_margin_px >= 0.0f && config.query_margin_px <= 16.0f))

@@ -132,6 +132,7 @@ void Renderer::Impl::enter_query_state(BackendStats& stats) {
 
 void Renderer::Impl::draw_objects(std::span<const ObjectId> ids, BackendStats& stats) {
   enter_render_state(stats);
+  if (options.draw == DrawMode::indirect) return indirect_draw(ids, stats);
   for (std::size_t begin = 0; begin < ids.size();) {
     // One run of objects with the same material: one material bind, then
     // either one multi-draw or one draw per object.
@@ -146,9 +147,9 @@ void Renderer::Impl::draw_objects(std::span<const ObjectId> ids, BackendStats& s
       ++stats.material_changes;
     }
     const auto run = ids.subspan(begin, end - begin);
-    if (options.multi_draw && run.size() >= kMinMultiDrawRun) {
+    if (options.draw == DrawMode::multi && run.size() >= kMinMultiDrawRun) {
       multi_draw(run);
-    } else if (options.multi_draw) {
+    } else if (options.draw == DrawMode::multi) {
       // A short run: a buffer upload and an indirect draw cost more than the
       // draws they replace. The multi-draw program reads the object index
       // from the instance attribute, so each object is its own base instance.
@@ -196,8 +197,21 @@ void Renderer::Impl::multi_draw(std::span<const ObjectId> ids) {
   indirect_offset += bytes;
 }
 
+// DrawMode::indirect: every object of `ids` in one multi-draw with the device
+// draw program (renderer_device.cpp), in the order given. The caller has set
+// the pass's masks and depth state (enter_render_state and what it changes
+// after); only the program and vertex array change here.
+void Renderer::Impl::indirect_draw(std::span<const ObjectId> ids, BackendStats& stats) {
+  if (ids.empty()) return;
+  use_device_draw();
+  multi_draw(ids);
+  for (ObjectId id : ids) stats.triangles += scene.object(id).triangles;
+  stats.draw_calls += ids.size();
+  stats.objects_rendered += ids.size();
+}
+
 void Renderer::Impl::upload_dynamic_transforms() {
-  if (!options.multi_draw && !device) return;  // single draws pass each matrix with its draw
+  if (options.draw == DrawMode::single && !device) return;  // single draws pass each matrix with its draw
   for (ObjectId id : scene.dynamic_objects()) {
     glNamedBufferSubData(object_buffer, GLintptr(id * sizeof(glm::mat4)), sizeof(glm::mat4),
                          glm::value_ptr(scene.object(id).transform));
@@ -306,7 +320,7 @@ void Renderer::render(std::span<const ObjectId> objects) {
   ScopedTimer timer(stats_.backend_ms);
   ++stats_.render_flushes;
   g.split_translucent(objects, g.translucent);
-  g.sort_opaque_by_material();
+  if (g.options.draw != DrawMode::indirect) g.sort_opaque_by_material();  // one draw for all materials
   if (!g.opaque.empty()) g.draw_objects(g.opaque, stats_);
 }
 

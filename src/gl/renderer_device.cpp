@@ -373,24 +373,24 @@ void Renderer::Impl::dispatch_cull(int phase, GLuint visibility) {
   mode = Mode::none;
 }
 
+void Renderer::Impl::use_device_draw() {
+  start_device_frame();
+  glUseProgram(device->draw_program);
+  glBindVertexArray(device->draw_vao);
+}
+
 // Draws command region `region` (0: phase 1, 1: phase 2 opaque, 2: translucent).
 void Renderer::Impl::device_draw(int region, BackendStats& stats) {
   DeviceState& d = *device;
   const bool blended = region == 2;
-  glUseProgram(d.draw_program);
-  glBindVertexArray(d.draw_vao);
-  glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
-  glDepthMask(blended ? GL_FALSE : GL_TRUE);
+  enter_render_state(stats);
+  use_device_draw();
   if (blended) {  // as the renderer's own translucent draws: no depth or id writes
+    glDepthMask(GL_FALSE);
     glColorMaski(1, GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
     glEnable(GL_BLEND);
     glBlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
   }
-  glDepthFunc(depth_less());
-  glDisable(GL_DEPTH_CLAMP);
-  glDisable(GL_POLYGON_OFFSET_FILL);
-  if (options.cull_backfaces) glEnable(GL_CULL_FACE); else glDisable(GL_CULL_FACE);
-  if (conservative_cap) glDisable(conservative_cap);
   glBindBuffer(GL_DRAW_INDIRECT_BUFFER, d.commands);
   const auto per_region = std::max<std::size_t>(object_capacity, 1);
   const auto* offset = reinterpret_cast<const void*>(std::size_t(region) * per_region * sizeof(DrawCommand));
@@ -495,8 +495,8 @@ void Renderer::draw_newly_visible(Visibility v, int texels) {
   g.start_device_frame();
   if (!g.device->pyramid_built)
     throw std::logic_error("gl::Renderer::draw_newly_visible: build_depth_pyramid() has not run in this frame");
-  if (texels != 2 && texels != 4 && texels != 8)
-    throw std::logic_error(fmt::format("gl::Renderer::draw_newly_visible: {} texels per axis (2, 4 or 8)", texels));
+  if (texels != 2 && texels != 4 && texels != 8 && texels != 16)
+    throw std::logic_error(fmt::format("gl::Renderer::draw_newly_visible: {} texels per axis (2, 4, 8 or 16)", texels));
   glProgramUniform1i(g.device->cull_program, g.device->u_texels, texels);
   g.stamp(4);
   g.dispatch_cull(2, buffer);

@@ -178,6 +178,10 @@ struct Renderer::Impl {
   void enter_query_state(BackendStats& stats);
   void draw_objects(std::span<const ObjectId> ids, BackendStats& stats);
   void multi_draw(std::span<const ObjectId> ids);
+  void indirect_draw(std::span<const ObjectId> ids, BackendStats& stats);
+  // Binds the device draw program (made on first use) and its vertex array,
+  // with this frame's uniforms; the render state's masks stay as they are.
+  void use_device_draw();
   void upload_dynamic_transforms();
   // `objects` into `opaque` (cleared first) and `translucent` (appended to),
   // each in the order given.

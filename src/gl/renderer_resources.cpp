@@ -289,9 +289,9 @@ void Renderer::Impl::create_scene_buffers() {
     materials.push_back({color, std::max(0, m.shading_cost)});
   }
 
-  if (options.multi_draw) add_object_attribute(scene_vao);
+  if (options.draw == DrawMode::multi) add_object_attribute(scene_vao);
 
-  const std::string header = options.multi_draw ? "#version 450 core\n#define OCCULL_MULTI_DRAW 1\n"
+  const std::string header = options.draw == DrawMode::multi ? "#version 450 core\n#define OCCULL_MULTI_DRAW 1\n"
                                                  : "#version 450 core\n";
   scene_program = make_program("scene", header + kSceneVertex, header + kSceneFragment);
   u_scene_view_proj = glGetUniformLocation(scene_program, "u_view_proj");

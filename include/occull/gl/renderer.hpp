@@ -41,6 +41,18 @@ enum class QueryRaster : std::uint8_t {
   exact,
 };
 
+/// How render() submits its objects.
+enum class DrawMode : std::uint8_t {
+  single,    ///< one draw per object, its matrix and id as uniforms (as scene-graph engines do)
+  multi,     ///< one glMultiDrawElementsIndirect per material run (commands written by the CPU)
+  /// One glMultiDrawElementsIndirect per render() call over every material:
+  /// the draw path of device culling (its program, per-object instanced
+  /// attributes, one command per object), with the commands written by the
+  /// CPU. `vfc --draw indirect` beside `hiz` separates the cost of
+  /// submission from the cost of culling.
+  indirect,
+};
+
 struct RendererOptions {
   int width = 1280;   ///< render-target size in pixels, 1..limits::viewport_side (else Renderer throws InputError)
   int height = 720;
@@ -50,9 +62,8 @@ struct RendererOptions {
   /// back faces culled whatever this says (two-sided only for a query with a
   /// box around the eye, see Renderer).
   bool cull_backfaces = true;
-  /// Submit each material run of a render() call as one glMultiDrawElementsIndirect
-  /// instead of one draw per object (same pixels; less driver overhead per object).
-  bool multi_draw = false;
+  /// How render() submits objects (same pixels whichever).
+  DrawMode draw = DrawMode::single;
   /// Device culling draws with glMultiDrawElementsIndirectCount over the
   /// commands the device compacted, where the driver has it; off: always
   /// the fallback (one command per object, glMultiDrawElementsIndirect),
