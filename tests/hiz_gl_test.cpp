@@ -242,3 +242,18 @@ TEST_F(Hiz, PhaseTwoWithoutAPyramidIsRefused) {
   r.end_frame();
   r.destroy_visibility(v);
 }
+
+TEST_F(Hiz, ReleaseHandsBackTheCullersVisibility) {
+  WallScene w;
+  gl::Renderer r(w.scene, target());
+  auto hiz = make_culler("hiz", {w.scene, w.bvh});
+  (void)frame(*hiz, r, w.scene, w.view);  // makes the device's buffers and the culler's visibility
+  const std::size_t holding = r.resources().buffers;
+  hiz->release(r);
+  EXPECT_EQ(r.resources().buffers, holding - 1);
+  (void)frame(*hiz, r, w.scene, w.view);  // usable after release: a new visibility, from nothing visible
+  EXPECT_EQ(r.resources().buffers, holding);
+  hiz->release(r);
+  hiz->release(r);  // twice is harmless
+  EXPECT_EQ(r.resources().buffers, holding - 1);
+}

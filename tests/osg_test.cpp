@@ -204,6 +204,15 @@ TEST(OsgCullingGroup, AnUnknownAlgorithmIsRefusedListingTheValidOnes) {
   }
 }
 
+TEST(OsgCullingGroup, ACullerThatNeedsDeviceCullingIsRefusedAtOnce) {
+  try {
+    osg::ref_ptr<OcclusionCullingGroup> group = new OcclusionCullingGroup("hiz:texels=4");
+    FAIL() << "made a group with hiz over a backend without device culling";
+  } catch (const occull::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("DeviceCulling"), std::string::npos) << e.what();
+  }
+}
+
 // The exported city (shared meshes, one transform per object, moving cars)
 // flown in OSG: occull's conservative rows miss nothing, and culled something.
 TEST(OsgBench, OccullRowsInsideOsgMissNoVisibleObjectOverAPath) {

@@ -93,7 +93,8 @@ class Culler {
   /// set for shadow passes, reflections, LOD and streaming. Every object of
   /// the frustum it does not hold was found occluded (or, for a culler that
   /// is not conservative, culled); objects_not_drawn() lists those. Valid
-  /// until the next render_frame().
+  /// until the next render_frame(). Empty for a culler that draws on the
+  /// device (`hiz`): the device holds what it drew (DeviceCulling::read_drawn).
   [[nodiscard]] std::span<const ObjectId> drawn_objects() const;
 
   /// Optional feedback: the owner calls it once the frame rendered by the

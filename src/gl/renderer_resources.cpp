@@ -445,7 +445,15 @@ Renderer::Resources Renderer::resources() const {
   Resources r;
   r.queries = g.query_names.size();
   r.queries_free = g.free_queries.size();
-  for (const GLuint b : g.buffer_names()) {
+  std::vector<GLuint> buffers;
+  for (const GLuint b : g.buffer_names()) buffers.push_back(b);
+  if (g.device) {  // device culling's, and each culler's visibility
+    const detail::DeviceState& d = *g.device;
+    buffers.insert(buffers.end(), {d.objects, d.shading, d.drawn, d.commands, d.counts});
+    for (const GLuint v : d.visibility)
+      if (v) buffers.push_back(v);
+  }
+  for (const GLuint b : buffers) {
     GLint64 size = 0;
     glGetNamedBufferParameteri64v(b, GL_BUFFER_SIZE, &size);
     r.buffer_bytes += size;

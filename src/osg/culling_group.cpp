@@ -3,6 +3,7 @@
 #include "occull/osg/culling_group.hpp"
 
 #include "occull/bvh.hpp"
+#include "occull/error.hpp"
 #include "occull/view.hpp"
 #include "gatherer.hpp"
 #include "osg_backend.hpp"
@@ -139,6 +140,11 @@ void OcclusionCullingGroup::set_algorithm(std::string algorithm, Options options
   Scene empty;
   const Bvh bvh = Bvh::build(empty);
   (void)make_culler(algorithm, {empty, bvh}, options, context_);
+  const AlgorithmSpec spec = parse_algorithm_spec(algorithm, options);
+  if (find_algorithm(spec.name).device)
+    throw InputError(fmt::format("{} culls on the device, and the group's backend over osg::State has no device "
+                                 "culling (DeviceCulling); use a culler that issues queries",
+                                 spec.name));
   std::lock_guard lock(mutex_);
   algorithm_ = std::move(algorithm);
   options_ = std::move(options);

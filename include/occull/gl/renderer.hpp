@@ -239,7 +239,7 @@ class Renderer final : public Backend, public DeviceCulling {
   struct Resources {
     std::size_t queries = 0;       ///< occlusion query objects created (the pool: in use and free)
     std::size_t queries_free = 0;  ///< ... of them free for the next issue_query()
-    std::size_t buffers = 0;       ///< buffer objects
+    std::size_t buffers = 0;       ///< buffer objects (device culling's and its visibilities included)
     std::int64_t buffer_bytes = 0; ///< their sizes as GL reports them (GL_BUFFER_SIZE), bytes
   };
   /// Precondition: the renderer's context is current; not between
