@@ -352,21 +352,36 @@ TEST(Cli, EveryQueryModeRunsVerifiedWithoutMisses) {
   EXPECT_EQ(run(std::string("bench ") + kTinyCity + " --query-mode some --no-report").code, 2);
 }
 
-TEST(Cli, MultiDrawSubmitsTheSameObjectsAsSingleDraws) {
-  std::vector<std::string> rows[2];
+TEST(Cli, EveryDrawModeSubmitsTheSameObjects) {
+  std::vector<std::string> rows[3];
   int i = 0;
-  for (const char* draw : {"single", "multi"}) {
+  for (const char* draw : {"single", "multi", "indirect"}) {
     const CliRun r = run(std::string("bench ") + kTinyCity + " --algo vfc,oracle --frames 4 --warmup 0 --no-report --draw " + draw);
     ASSERT_EQ(r.code, 0) << draw << "\n" << r.output;
     rows[i++] = table_row(r.output, "vfc");
   }
-  ASSERT_GT(rows[0].size(), std::size_t(kTriangles));
-  ASSERT_GT(rows[1].size(), std::size_t(kTriangles));
-  EXPECT_EQ(rows[0][kDraws], rows[1][kDraws]);
-  EXPECT_EQ(rows[0][kTriangles], rows[1][kTriangles]);
+  for (int k = 0; k < 3; ++k) ASSERT_GT(rows[k].size(), std::size_t(kTriangles));
+  for (int k : {1, 2}) {
+    EXPECT_EQ(rows[0][kDraws], rows[k][kDraws]);
+    EXPECT_EQ(rows[0][kTriangles], rows[k][kTriangles]);
+  }
   const CliRun bad = run(std::string("bench ") + kTinyCity + " --draw batched --no-report");
   EXPECT_EQ(bad.code, 2);
-  EXPECT_NE(bad.output.find("valid modes: single, multi"), std::string::npos) << bad.output;
+  EXPECT_NE(bad.output.find("valid modes: single, multi, indirect"), std::string::npos) << bad.output;
+}
+
+// hiz runs from the command line, verified, beside vfc, with its device
+// times in the JSON.
+TEST(Cli, HizRunsVerifiedWithItsDeviceTimes) {
+  const std::string json = ::testing::TempDir() + "occull_cli_hiz.json";
+  std::remove(json.c_str());
+  const CliRun r = run(std::string("bench ") + kTinyCity + " --algo vfc,hiz --frames 4 --warmup 1 --no-report --json " + json);
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("missed no visible object"), std::string::npos) << r.output;
+  std::ifstream in(json);
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  EXPECT_NE(text.find("\"pyramid_ms_per_frame\""), std::string::npos);
+  EXPECT_NE(text.find("\"device_cull_ms_per_frame\""), std::string::npos);
 }
 
 TEST(Cli, QueryGeometryIsReportedAndSelectable) {
