@@ -3,6 +3,10 @@
 
 #include "occull/gl/renderer.hpp"
 
+#include <cstdint>
+#include <set>
+#include <vector>
+
 namespace occull::test {
 
 /// Renderer options for a width x height target without id writes (the
@@ -13,6 +17,14 @@ inline gl::RendererOptions small_target(int width, int height) {
   o.height = height;
   o.write_ids = false;
   return o;
+}
+
+/// The objects an id image (gl::Renderer::read_ids) shows.
+inline std::set<ObjectId> ids_in(const std::vector<std::uint32_t>& pixels) {
+  std::set<ObjectId> ids;
+  for (std::uint32_t p : pixels)
+    if (p != 0) ids.insert(p - 1);
+  return ids;
 }
 
 }  // namespace occull::test

@@ -9,6 +9,7 @@
 #include "occull/gl/renderer.hpp"
 #include "occull/recording_backend.hpp"
 #include "occull/scenes.hpp"
+#include "gl_test_util.hpp"
 #include "test_util.hpp"
 
 #include <glm/gtc/matrix_transform.hpp>
@@ -61,12 +62,7 @@ std::vector<ObjectId> frame(Culler& culler, gl::Renderer& r, const Scene& scene,
   return drawn;
 }
 
-std::set<ObjectId> ids_in(const std::vector<std::uint32_t>& pixels) {
-  std::set<ObjectId> ids;
-  for (std::uint32_t p : pixels)
-    if (p != 0) ids.insert(p - 1);
-  return ids;
-}
+using test::ids_in;
 
 }  // namespace
 

@@ -6,6 +6,7 @@
 #include "occull/gl/renderer.hpp"
 #include "occull/recording_backend.hpp"
 #include "occull/harness.hpp"
+#include "gl_test_util.hpp"
 #include "test_util.hpp"
 
 #include <fmt/format.h>
@@ -53,12 +54,7 @@ void begin_with_wall(gl::Renderer& r, const WallScene& w) {
   r.render(wall);
 }
 
-std::set<ObjectId> ids_in(const std::vector<std::uint32_t>& pixels) {
-  std::set<ObjectId> ids;
-  for (std::uint32_t p : pixels)
-    if (p != 0) ids.insert(p - 1);
-  return ids;
-}
+using test::ids_in;
 
 }  // namespace
 
