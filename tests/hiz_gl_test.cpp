@@ -189,9 +189,11 @@ TEST_F(Hiz, FollowsObjectsRemovedAndAddedBack) {
   w.scene.remove_object(WallScene::beside);
   w.bvh.refit(w.scene);
   EXPECT_EQ(frame(*hiz, r, w.scene, w.view), (std::vector<ObjectId>{WallScene::wall}));
-  // The slot comes back as a box in front of the wall.
-  const MeshId mesh = w.scene.add_mesh(test::box_mesh({{-0.5f, -0.5f, -6}, {0.5f, 0.5f, -5}}));
-  ASSERT_EQ(w.scene.add_object(mesh, 0, glm::mat4(1.0f), OccluderClass::always), WallScene::beside);
+  // The slot comes back as the hidden box's mesh moved in front of the wall
+  // (the renderer keeps the meshes it was made with).
+  const glm::mat4 in_front = glm::translate(glm::mat4(1.0f), glm::vec3(0.0f, 0.0f, 14.0f));
+  ASSERT_EQ(w.scene.add_object(w.scene.object(WallScene::hidden).mesh, 0, in_front, OccluderClass::always),
+            WallScene::beside);
   w.bvh.refit(w.scene);
   EXPECT_EQ(frame(*hiz, r, w.scene, w.view), (std::vector<ObjectId>{WallScene::wall, WallScene::beside}));
   hiz->release(r);

@@ -102,8 +102,10 @@ bool DepthPyramid::occluded(const Aabb& box, const glm::mat4& view_proj, const C
   const Level& l = levels_[std::size_t(level)];
   // The rectangle's texels at that level, at most `texels` from its first
   // along each axis (all of them at the right level).
-  const int tx = x0 >> level, ty = y0 >> level;
-  const int tx1 = std::min(x1 >> level, tx + texels - 1), ty1 = std::min(y1 >> level, ty + texels - 1);
+  // (Within the level: sizes rounded down, rule 2 broken, leave fewer texels.)
+  const int tx = std::min(x0 >> level, l.width - 1), ty = std::min(y0 >> level, l.height - 1);
+  const int tx1 = std::min({x1 >> level, tx + texels - 1, l.width - 1});
+  const int ty1 = std::min({y1 >> level, ty + texels - 1, l.height - 1});
   float farthest = -inf;
   for (int y = ty; y <= ty1; ++y)
     for (int x = tx; x <= tx1; ++x)

@@ -132,7 +132,7 @@ bool occluded(vec3 lo, vec3 hi) {
   int level = extent <= 1 ? 0 : findMSB(uint(extent - 1)) + 1;
   level = clamp(level - findMSB(uint(u_texels)) + 1, 0, u_levels - 1);
   ivec2 t0 = p0 >> level;
-  ivec2 t1 = min(p1 >> level, t0 + u_texels - 1);
+  ivec2 t1 = min(min(p1 >> level, t0 + u_texels - 1), u_level_size[level] - 1);
   float farthest = -1e30;
   for (int y = t0.y; y <= t1.y; ++y)
     for (int x = t0.x; x <= t1.x; ++x) farthest = max(farthest, key(level_texel(level, ivec2(x, y))));

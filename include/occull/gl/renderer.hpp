@@ -125,10 +125,10 @@ struct RendererOptions {
 /// renderer's whole life; `scene` outlives the renderer and keeps its
 /// meshes. Objects may move (update(), set_transform, place_object), be
 /// removed and have their ids reused; objects added past the count the scene
-/// had when the renderer was made are refused (std::logic_error at the next
-/// frame: make a new renderer). Query calls check that the query is in
-/// flight (issued by this renderer, not yet read) and throw
-/// std::logic_error otherwise.
+/// had when the renderer was made, and meshes added after it, are refused
+/// (std::logic_error at the next frame: make a new renderer). Query calls
+/// check that the query is in flight (issued by this renderer, not yet read)
+/// and throw std::logic_error otherwise.
 class Renderer final : public Backend, public DeviceCulling {
  public:
   Renderer(const Scene& scene, const RendererOptions& options);
