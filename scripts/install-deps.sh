@@ -13,6 +13,8 @@ packages=(
   # libraries
   libglm-dev libfmt-dev libcli11-dev nlohmann-json3-dev libstb-dev libtinyxml2-dev
   libminizip-dev libassimp-dev
+  # Highway: the CPU occlusion buffer's inner loops (soc), SIMD with run-time dispatch
+  libhwy-dev
   # OpenSceneGraph: occull_osg (a culling group inside OSG) and `occull osg`, which measures it
   # beside OSG's own osg::OcclusionQueryNode in one viewer; openscenegraph brings its file plugins
   libopenscenegraph-dev openscenegraph

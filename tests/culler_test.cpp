@@ -40,7 +40,7 @@ TEST(Registry, UnknownAlgorithmListsTheValidOnes) {
     (void)make_culler("nope", {scene, bvh});
     FAIL() << "no error";
   } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("none, vfc, stopwait, perobject, chc, chcpp, nohc, grid, hiz, auto, tilevfc, pertile, tiles, oracle"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("none, vfc, stopwait, perobject, chc, chcpp, nohc, grid, hiz, soc, auto, tilevfc, pertile, tiles, oracle"), std::string::npos) << e.what();
   }
 }
 

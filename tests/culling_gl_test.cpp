@@ -22,7 +22,8 @@ const char* const kConservative[] = {
     "stopwait", "chc", "chc:skip=4", "chcpp", "chcpp:batch=1", "chcpp:vqueue=off",
     "chcpp:multiquery=off", "chcpp:jitter=off", "chcpp:tight=off", "chcpp:virtual_leaf=0", "nohc",
     "auto:trial=1:period=2",  // auto switching every few frames: each candidate returns to stale state
-    "hiz", "hiz:texels=2", "hiz:texels=16"};
+    "hiz", "hiz:texels=2", "hiz:texels=16",
+    "soc", "soc:scale=1", "soc:width=64:height=36", "soc:width=131:height=47", "soc:simd=off"};
 
 gl::RendererOptions small_target() { return test::small_target(192, 108); }
 
@@ -150,6 +151,6 @@ TEST(ConservativeCullers, EngineMovedObjectsAreFollowedWithoutMisses) {
     session.release(*culler);
     return missed;
   };
-  for (const char* spec : {"vfc", "chc", "chcpp", "nohc", "stopwait", "auto", "hiz"})
+  for (const char* spec : {"vfc", "chc", "chcpp", "nohc", "stopwait", "auto", "hiz", "soc"})
     EXPECT_EQ(truth_and_run(spec), 0u) << spec;
 }

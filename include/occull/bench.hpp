@@ -86,6 +86,11 @@ struct AlgorithmSummary {
   double gpu_ms_per_frame = 0.0;
   double pyramid_ms_per_frame = 0.0;      ///< GPU time building depth pyramids (hiz)
   double device_cull_ms_per_frame = 0.0;  ///< GPU time of device culling's dispatches (hiz)
+  double raster_ms_per_frame = 0.0;       ///< CPU time rasterizing occluders (soc)
+  double test_ms_per_frame = 0.0;         ///< CPU time testing boxes against the occlusion buffer (soc)
+  double occluder_triangles_per_frame = 0.0;  ///< triangles rasterized into the occlusion buffer (soc)
+  double boxes_tested_per_frame = 0.0;    ///< boxes tested against the occlusion buffer (soc)
+  double buffer_texels = 0.0;             ///< the occlusion buffer's texels (soc; median over frames)
   double model_ms_per_frame = 0.0;        ///< cost-model prediction (0 without --model)
   double cpu_us_per_node = 0.0;           ///< culler CPU time per visited node, microseconds (0: no nodes)
   double kernel_ms_per_frame = 0.0;       ///< process CPU time in the kernel (FrameStats::kernel_ms)

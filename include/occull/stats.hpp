@@ -20,6 +20,8 @@ struct FrameStats {
   double kernel_ms = 0.0; ///< CPU time the whole process spent in the kernel during the frame
   double pyramid_ms = 0.0;      ///< GPU time building depth pyramids (device culling: hiz)
   double device_cull_ms = 0.0;  ///< GPU time of device culling's test-and-write-commands dispatches
+  double raster_ms = 0.0;  ///< CPU time rasterizing occluders into the occlusion buffer (soc; part of cpu_ms)
+  double test_ms = 0.0;    ///< CPU time testing boxes against the occlusion buffer (soc; part of cpu_ms)
 
   // What the operating system did during the frame (whole process, driver
   // threads included): page faults are allocator churn, not algorithm cost.
@@ -38,6 +40,11 @@ struct FrameStats {
   std::uint64_t over_cap = 0;    ///< queries due but deferred by the cap
   double result_age = 0.0;       ///< mean frames since the query behind each answer used was issued
   std::uint64_t revealed = 0;    ///< hidden cells whose query found them visible and were drawn in its frame
+
+  // CPU occlusion buffer (soc).
+  std::uint64_t occluder_triangles = 0;  ///< triangles rasterized into the buffer (after clipping, front faces)
+  std::uint64_t boxes_tested = 0;        ///< node and object boxes tested against the buffer
+  std::uint64_t buffer_texels = 0;       ///< the buffer's width × height
 
   // Tiled worlds (tilevfc, pertile, tiles; Gomez et al. 2013).
   std::uint64_t tiles_rendered = 0;      ///< tile instances drawn (culled inside by their own culler, if any)

@@ -22,7 +22,7 @@ const std::vector<Registration>& registry() {
         detail::none_registration(),    detail::vfc_registration(),     detail::stopwait_registration(),
         detail::perobject_registration(), detail::chc_registration(),   detail::chcpp_registration(),
         detail::nohc_registration(),    detail::grid_registration(),    detail::hiz_registration(),
-        detail::auto_registration(),
+        detail::soc_registration(),     detail::auto_registration(),
         detail::tilevfc_registration(), detail::pertile_registration(), detail::tiles_registration(),
     };
     // The oracle is made by the harness (it needs each frame's ground truth).

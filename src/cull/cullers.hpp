@@ -15,6 +15,7 @@ Registration chcpp_registration();
 Registration nohc_registration();
 Registration grid_registration();
 Registration hiz_registration();
+Registration soc_registration();
 Registration auto_registration();
 Registration tilevfc_registration();
 Registration pertile_registration();

@@ -1,0 +1,192 @@
+// occull — a strictly conservative CPU occlusion buffer: a low-resolution
+// depth buffer into which occluder triangles are rasterized and against which
+// boxes are tested, on the CPU, with no GL and no round trip (the `soc`
+// culler; the first test `chcpp:cpu_test=on` and `nohc:cpu_test=on` make
+// before a query).
+//
+// A box is found hidden only when every pixel of the viewport it could cover
+// is covered by an occluder triangle that is drawn in the same frame and lies
+// nearer than the box's nearest point. Well-known CPU buffers are not
+// conservative (a triangle covers a buffer texel when it covers the texel's
+// centre, so at a resolution below the screen's an object seen through a
+// sub-texel gap is hidden); this one keeps the promise by these rules. Each
+// has the test in tests/occlusion_buffer_test.cpp that fails without it
+// (OcclusionRules switches it off):
+//
+//  1. Occluders are clipped at the near plane in clip space (the GPU draws
+//     nothing in front of it), and at a guard band far outside the viewport
+//     so that every coordinate fits the fixed-point edge functions (rule 3);
+//     clipping is done in double precision. Clipping only at a plane just in
+//     front of the eye would let the part between it and the near plane,
+//     which is never drawn, hide what lies behind it.
+//                                        (AnOccluderInFrontOfTheNearPlaneHidesNothing)
+//  2. Only front faces occlude (counter-clockwise in window coordinates, as
+//     occull's meshes wind them): a renderer culling back faces does not
+//     draw the others. Degenerate triangles are skipped.
+//                                        (ABackFacingOccluderHidesNothing)
+//  3. Coverage is inner-conservative. Vertices are snapped to 1/256 texel
+//     and edge functions are evaluated exactly in 64-bit integers. A texel
+//     is covered only if the whole texel, grown by 1/64 texel on every side,
+//     lies strictly inside all three edges (the edge function at the
+//     texel's corner farthest outside each edge is > 0: ties are not
+//     covered). The growth covers both rasterizers' vertex snapping (ours
+//     1/512 texel, the GPU's 1/512 pixel, a pixel being no larger than a
+//     texel) and float projection. Covering a texel when its centre is
+//     inside (the GPU's point-sampling rule, MOC's) hides objects seen
+//     through gaps narrower than a texel. A texel covered by two triangles
+//     together but by neither alone is not covered: occlusion lost at seams,
+//     never a miss.            (AGapNarrowerThanATexelKeepsWhatIsBehindItVisible,
+//                               AnOccluderCoveringHalfATexelCoversNothing)
+//  4. Each covered texel takes the occluder's farthest depth over it: the
+//     triangle's depth plane (window depth is affine in window coordinates)
+//     at the grown texel's farthest corner, no farther than the polygon's
+//     farthest vertex, plus a bias of 2^-20 of its depths for float
+//     evaluation and of how far its corners lie off that plane. A texel keeps the nearest of its occluders' values
+//     (every one of them bounds what can be seen there). Depth at the
+//     texel's centre lets a box poke through a slanted occluder.
+//                                        (ASlantedOccluderHidesOnlyWhatIsBehindItsFarthestPoint)
+//  5. A box is tested over every texel its screen rectangle touches: its 8
+//     corners projected, the rectangle grown by 1/64 texel, floored to whole
+//     texels. Texels whose centre lies in the rectangle are not enough.
+//                                        (ABoxReachingIntoAnUncoveredTexelIsVisible)
+//  6. A box is tested at its nearest depth: the nearest of its 8 corners.
+//                                        (ADeepBoxIsTestedAtItsNearestCorner)
+//  7. A box crossing the near plane or reaching behind the eye is visible.
+//                                        (ABoxReachingTheEyeIsVisible)
+//  8. Ties are visible, with the depth margin of the depth pyramid's rule 7
+//     (depth_tolerance in occull/depth_pyramid.hpp): hidden only when the
+//     box's nearest depth is farther than the texel's by more than it.
+//                                        (DepthTiesAreVisible)
+//  9. Reversed-Z: depths are compared as keys, larger farther (the window
+//     depth, negated with reversed-Z).  (ReversedZHidesWhatIsBehindOnly)
+// The buffer is hierarchical: each tile of 8×8 texels keeps its farthest
+// key (refreshed when a test reads a tile written since), and a box whose
+// nearest depth is behind a tile's farthest needs no texel of that tile
+// (tested equal to the texel-only answer: TilesAnswerAsTexelsDo).
+//
+// What a caller must guarantee: an occluder rasterized in a frame is drawn
+// in that frame, opaque, writing depth with a less(-or-equal) test, and with
+// the same matrices. Objects with a box crossing the near plane are
+// visible, so an occluder through the eye hides nothing behind itself that
+// a GPU would show.
+//
+// The inner loops (each texel row's depth writes, each tile's and box row's
+// farthest key) are vectorised with Highway (libhwy-dev) with run-time
+// dispatch between the instruction sets the CPU has; SimdPath::scalar runs
+// the plain C++ reference, equal bit for bit (SimdMatchesScalar).
+#pragma once
+
+#include "occull/geometry.hpp"
+
+#include <glm/mat4x4.hpp>
+
+#include <cstdint>
+#include <span>
+#include <string>
+#include <vector>
+
+namespace occull {
+
+/// The rules of the header, each switchable to show what breaks without it
+/// (tests only; the defaults are the conservative buffer).
+struct OcclusionRules {
+  bool clip_near = true;            ///< rule 1; false: clipped at w = 1e-5 only
+  bool front_faces_only = true;     ///< rule 2; false: back faces rasterized too
+  bool inner_coverage = true;       ///< rule 3; false: a texel is covered when its centre is inside
+  bool farthest_depth = true;       ///< rule 4; false: the depth at the texel's centre
+  bool outer_rectangle = true;      ///< rule 5; false: only texels whose centre is in the box's rectangle
+  bool nearest_corner = true;       ///< rule 6; false: the box's centre depth
+  bool reaching_eye_visible = true; ///< rule 7; false: corners behind the eye or near plane dropped
+  bool depth_margin = true;         ///< rule 8; false: hidden when the box's depth is not nearer (ties hidden)
+};
+
+/// Which code runs the inner loops.
+enum class SimdPath : std::uint8_t {
+  best,    ///< the widest instruction set this CPU has (Highway's run-time dispatch)
+  scalar,  ///< the plain C++ reference
+};
+
+/// Name of the instruction set SimdPath::best runs on this CPU ("AVX2", "SSE4", ...).
+[[nodiscard]] std::string simd_target_name();
+
+/// An occluder mesh made ready for the buffer: its triangles, each pair that
+/// shares an edge, lies in one plane and makes a convex quad merged into that
+/// quad (so that the diagonal of a wall's quad is no seam of uncovered
+/// texels, rule 3), largest inscribed circle first, so that a caller
+/// rasterizes only the polygons that can cover a texel whole from where the
+/// camera is (a polygon covering a texel holds a circle of half a texel).
+/// Built once per mesh.
+struct OccluderMesh {
+  static constexpr std::uint32_t no_corner = 0xffffffffu;  ///< a triangle's fourth corner
+  std::vector<std::uint32_t> corners;  ///< 4 per polygon, counter-clockwise; no_corner last for a triangle
+  std::vector<float> inradius;         ///< per polygon, an upper bound (2 area / perimeter), object units, descending
+  [[nodiscard]] std::size_t polygons() const noexcept { return inradius.size(); }
+  /// How many leading polygons have an inradius of at least `radius`.
+  [[nodiscard]] std::size_t count_at_least(float radius) const noexcept;
+};
+/// Builds an OccluderMesh from a triangle mesh (3 indices per triangle;
+/// degenerate triangles left out). Edges are matched by vertex position, so
+/// meshes that do not share vertices merge too. Precondition: indices <
+/// positions.size().
+[[nodiscard]] OccluderMesh make_occluder_mesh(std::span<const glm::vec3> positions,
+                                              std::span<const std::uint32_t> indices);
+
+/// A width × height occlusion buffer over a viewport, and its box test.
+/// Not thread-safe; one per culler (and per view size).
+class OcclusionBuffer {
+ public:
+  static constexpr int tile_size = 8;  ///< texels per tile side
+
+  /// Preconditions: 1 <= width, height <= 8192.
+  OcclusionBuffer(int width, int height, SimdPath simd = SimdPath::best, const OcclusionRules& rules = {});
+
+  [[nodiscard]] int width() const noexcept { return width_; }
+  [[nodiscard]] int height() const noexcept { return height_; }
+  [[nodiscard]] SimdPath simd() const noexcept { return simd_; }
+
+  /// Starts a frame: every texel empty (farthest), depths compared with the
+  /// conventions `clip` from now on.
+  void clear(const ClipSpace& clip);
+
+  /// Rasterizes the triangles `indices` (3 per triangle) of `positions`,
+  /// transformed by `object_to_clip` (view_proj * object transform), into
+  /// the buffer. Returns the triangles rasterized (front-facing, not clipped
+  /// away entirely, not degenerate). Precondition: indices < positions.size().
+  std::uint32_t rasterize(std::span<const glm::vec3> positions, std::span<const std::uint32_t> indices,
+                          const glm::dmat4& object_to_clip);
+  /// Rasterizes the first `count` polygons of `mesh` (made from `positions`).
+  /// Returns the polygons rasterized. Precondition: count <= mesh.polygons().
+  std::uint32_t rasterize(std::span<const glm::vec3> positions, const OccluderMesh& mesh, std::size_t count,
+                          const glm::dmat4& object_to_clip);
+
+  /// Whether `box` (world space) is hidden behind what was rasterized, seen
+  /// through `view_proj` (the same view). False means "may be visible".
+  /// An empty box, or one whose rectangle lies off the buffer, is visible
+  /// (the caller's frustum test decides those). Not const: refreshes the
+  /// farthest key of tiles written since they were last read.
+  [[nodiscard]] bool occluded(const Aabb& box, const glm::mat4& view_proj);
+
+  /// The texels' keys (window depth, negated with reversed-Z; +infinity
+  /// where nothing is rasterized), row-major, bottom row first.
+  [[nodiscard]] std::span<const float> keys() const noexcept { return keys_; }
+  /// Texel (x, y)'s key.
+  [[nodiscard]] float key_at(int x, int y) const { return keys_.at(std::size_t(y) * std::size_t(width_) + std::size_t(x)); }
+  /// Texels with something rasterized.
+  [[nodiscard]] std::size_t covered_texels() const noexcept;
+
+ private:
+  void raster_clipped(const glm::dvec4* clip, int n, std::uint32_t& count);
+  void raster_polygon(const glm::dvec3* v, int n, std::uint32_t& count);
+  float tile_farthest(int tx, int ty);
+
+  int width_, height_;
+  int tiles_x_, tiles_y_;
+  SimdPath simd_;
+  OcclusionRules rules_;
+  ClipSpace clip_;
+  std::vector<float> keys_;
+  std::vector<float> tile_far_;
+  std::vector<std::uint8_t> tile_dirty_;
+};
+
+}  // namespace occull

@@ -1,0 +1,484 @@
+// The CPU occlusion buffer: see occlusion_buffer.hpp for its rules. The
+// scalar reference loops are here; occlusion_buffer_simd.cpp vectorises them.
+#include "occull/occlusion_buffer.hpp"
+
+#include "occull/depth_pyramid.hpp"  // depth_tolerance: the same margin as the pyramid's
+#include "occlusion_buffer_simd.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cassert>
+#include <cmath>
+#include <limits>
+#include <bit>
+#include <unordered_map>
+#include <utility>
+
+namespace occull {
+namespace {
+
+constexpr float kInf = std::numeric_limits<float>::infinity();
+constexpr std::int64_t kSub = 256;        // fixed-point steps per texel (rule 3)
+constexpr std::int64_t kGrow = kSub / 64; // a texel grown by 1/64 on every side (rules 3, 5)
+constexpr double kGrowTexels = double(kGrow) / double(kSub);
+
+// The scalar references of occlusion_buffer_simd.hpp, kept scalar (the
+// compiler would otherwise vectorise them, and they are what the vector code
+// is measured against).
+[[gnu::optimize("no-tree-vectorize")]] void fill_span_scalar(float* row, int count, float base, float step,
+                                                             float cap) {
+  for (int i = 0; i < count; ++i) {
+    const float v = base + step * float(i);
+    const float depth = v < cap ? v : cap;
+    row[i] = row[i] < depth ? row[i] : depth;
+  }
+}
+
+[[gnu::optimize("no-tree-vectorize")]] float max_span_scalar(const float* row, int count) {
+  float best = -kInf;
+  for (int i = 0; i < count; ++i) best = best > row[i] ? best : row[i];
+  return best;
+}
+
+std::int64_t floor_div(std::int64_t a, std::int64_t b) {  // b > 0
+  const std::int64_t q = a / b;
+  return (a % b != 0 && a < 0) ? q - 1 : q;
+}
+
+// Rule 8: `nearest` (a box's key) lies behind `farthest` (a texel's or
+// tile's key) by more than depth rounding. +infinity hides nothing.
+bool behind(float nearest, float farthest, bool margin) {
+  return margin ? nearest > farthest + depth_tolerance(farthest) : nearest >= farthest;
+}
+
+}  // namespace
+
+std::string simd_target_name() { return simd::target_name(); }
+
+std::size_t OccluderMesh::count_at_least(float radius) const noexcept {
+  return std::size_t(std::partition_point(inradius.begin(), inradius.end(), [&](float r) { return r >= radius; }) -
+                     inradius.begin());
+}
+
+OccluderMesh make_occluder_mesh(std::span<const glm::vec3> positions, std::span<const std::uint32_t> indices) {
+  struct Tri {
+    std::uint32_t v[3];
+    glm::dvec3 normal;  // unnormalised: twice the area
+    bool merged = false;
+  };
+  std::vector<Tri> tris;
+  for (std::size_t i = 0; i + 2 < indices.size(); i += 3) {
+    Tri t{{indices[i], indices[i + 1], indices[i + 2]}, {}};
+    const glm::dvec3 a(positions[t.v[0]]), b(positions[t.v[1]]), c(positions[t.v[2]]);
+    t.normal = glm::cross(b - a, c - a);
+    if (glm::length(t.normal) > 0.0) tris.push_back(t);
+  }
+  // Directed edges by the bits of their end positions.
+  const auto bits = [&](std::uint32_t v) {
+    const glm::vec3& p = positions[v];
+    return std::array<float, 3>{p.x, p.y, p.z};
+  };
+  using Key = std::array<float, 6>;
+  struct Hash {
+    std::size_t operator()(const Key& k) const noexcept {
+      std::uint64_t h = 1469598103934665603ull;
+      for (float f : k) h = (h ^ std::bit_cast<std::uint32_t>(f)) * 1099511628211ull;
+      return std::size_t(h);
+    }
+  };
+  const auto key = [&](std::uint32_t a, std::uint32_t b) {
+    const auto pa = bits(a), pb = bits(b);
+    return Key{pa[0], pa[1], pa[2], pb[0], pb[1], pb[2]};
+  };
+  std::unordered_map<Key, std::size_t, Hash> edges;
+  edges.reserve(tris.size() * 3);
+  for (std::size_t t = 0; t < tris.size(); ++t)
+    for (int k = 0; k < 3; ++k) edges.emplace(key(tris[t].v[k], tris[t].v[(k + 1) % 3]), t);
+
+  struct Poly {
+    std::uint32_t c[4];
+    float radius;
+  };
+  std::vector<Poly> polys;
+  const auto add = [&](const std::uint32_t* c, int n) {
+    double area2 = 0.0, perimeter = 0.0;
+    glm::dvec3 sum(0.0);
+    for (int k = 0; k < n; ++k) {
+      const glm::dvec3 a(positions[c[k]]), b(positions[c[(k + 1) % n]]);
+      sum += glm::cross(a, b);
+      perimeter += glm::length(b - a);
+    }
+    area2 = glm::length(sum);
+    Poly p{{c[0], c[1], c[2], n == 4 ? c[3] : OccluderMesh::no_corner}, float(area2 / perimeter)};
+    polys.push_back(p);
+  };
+  for (std::size_t t = 0; t < tris.size(); ++t) {
+    if (tris[t].merged) continue;
+    tris[t].merged = true;
+    bool done = false;
+    for (int k = 0; k < 3 && !done; ++k) {
+      const std::uint32_t a = tris[t].v[k], b = tris[t].v[(k + 1) % 3], c = tris[t].v[(k + 2) % 3];
+      const auto it = edges.find(key(b, a));
+      if (it == edges.end() || tris[it->second].merged) continue;
+      Tri& u = tris[it->second];
+      const glm::dvec3 n1 = glm::normalize(tris[t].normal), n2 = glm::normalize(u.normal);
+      if (glm::dot(n1, n2) < 1.0 - 1e-9) continue;  // not one plane
+      std::uint32_t d = u.v[0];
+      for (std::uint32_t w : u.v)
+        if (bits(w) != bits(a) && bits(w) != bits(b)) d = w;
+      const std::uint32_t quad[4] = {a, d, b, c};
+      bool convex = true;
+      for (int q = 0; q < 4; ++q) {
+        const glm::dvec3 p0(positions[quad[q]]), p1(positions[quad[(q + 1) % 4]]), p2(positions[quad[(q + 2) % 4]]);
+        convex &= glm::dot(glm::cross(p1 - p0, p2 - p1), n1) > 0.0;
+      }
+      if (!convex) continue;
+      u.merged = true;
+      add(quad, 4);
+      done = true;
+    }
+    if (!done) add(tris[t].v, 3);
+  }
+  std::stable_sort(polys.begin(), polys.end(), [](const Poly& x, const Poly& y) { return x.radius > y.radius; });
+  OccluderMesh out;
+  out.corners.reserve(polys.size() * 4);
+  out.inradius.reserve(polys.size());
+  for (const Poly& p : polys) {
+    out.corners.insert(out.corners.end(), p.c, p.c + 4);
+    out.inradius.push_back(p.radius);
+  }
+  return out;
+}
+
+OcclusionBuffer::OcclusionBuffer(int width, int height, SimdPath simd, const OcclusionRules& rules)
+    : width_(width),
+      height_(height),
+      tiles_x_((width + tile_size - 1) / tile_size),
+      tiles_y_((height + tile_size - 1) / tile_size),
+      simd_(simd),
+      rules_(rules),
+      keys_(std::size_t(width) * std::size_t(height), kInf),
+      tile_far_(std::size_t(tiles_x_) * std::size_t(tiles_y_), kInf),
+      tile_dirty_(tile_far_.size(), 0) {
+  assert(width >= 1 && height >= 1 && width <= 8192 && height <= 8192);
+}
+
+void OcclusionBuffer::clear(const ClipSpace& clip) {
+  clip_ = clip;
+  std::fill(keys_.begin(), keys_.end(), kInf);
+  std::fill(tile_far_.begin(), tile_far_.end(), kInf);
+  std::fill(tile_dirty_.begin(), tile_dirty_.end(), std::uint8_t{0});
+}
+
+std::size_t OcclusionBuffer::covered_texels() const noexcept {
+  return std::size_t(std::count_if(keys_.begin(), keys_.end(), [](float k) { return k != kInf; }));
+}
+
+std::uint32_t OcclusionBuffer::rasterize(std::span<const glm::vec3> positions, std::span<const std::uint32_t> indices,
+                                         const glm::dmat4& object_to_clip) {
+  std::uint32_t count = 0;
+  for (std::size_t i = 0; i + 2 < indices.size(); i += 3) {
+    glm::dvec4 c[3];
+    for (int k = 0; k < 3; ++k) {
+      assert(indices[i + std::size_t(k)] < positions.size());
+      c[k] = object_to_clip * glm::dvec4(glm::dvec3(positions[indices[i + std::size_t(k)]]), 1.0);
+    }
+    raster_clipped(c, 3, count);
+  }
+  return count;
+}
+
+std::uint32_t OcclusionBuffer::rasterize(std::span<const glm::vec3> positions, const OccluderMesh& mesh,
+                                         std::size_t count, const glm::dmat4& object_to_clip) {
+  assert(count <= mesh.polygons());
+  std::uint32_t drawn = 0;
+  for (std::size_t p = 0; p < count; ++p) {
+    const std::uint32_t* corners = mesh.corners.data() + 4 * p;
+    const int n = corners[3] == OccluderMesh::no_corner ? 3 : 4;
+    glm::dvec4 c[4];
+    for (int k = 0; k < n; ++k) c[k] = object_to_clip * glm::dvec4(glm::dvec3(positions[corners[k]]), 1.0);
+    raster_clipped(c, n, drawn);
+  }
+  return drawn;
+}
+
+// Rule 1: clips a convex polygon at the near plane and the guard band (in
+// double, Sutherland-Hodgman), then rasterizes what is left.
+void OcclusionBuffer::raster_clipped(const glm::dvec4* clip, int vertices, std::uint32_t& count) {
+  // Every coordinate of a clipped vertex lies within 2^19 texels of the
+  // buffer: 2^27 fixed-point steps, so edge functions stay within int64.
+  const double guard = double(1 << 20) / double(std::max(width_, height_)) - 1.0;
+  const double near_depth = clip_.near_depth();
+  const auto distance = [&](const glm::dvec4& c, int plane) -> double {
+    switch (plane) {
+      case 0:
+        if (!rules_.clip_near) return c.w - 1e-5;
+        return clip_.reversed_z ? c.w - c.z : c.z - near_depth * c.w;
+      case 1: return guard * c.w - c.x;
+      case 2: return guard * c.w + c.x;
+      case 3: return guard * c.w - c.y;
+      default: return guard * c.w + c.y;
+    }
+  };
+  constexpr int kPlanes = 5;
+  constexpr int kMax = 4 + kPlanes;
+  glm::dvec4 poly[kMax], next[kMax];
+  int n = vertices;
+  std::copy(clip, clip + n, poly);
+  for (int p = 0; p < kPlanes; ++p) {
+    double d[kMax];
+    bool any_out = false, all_out = true;
+    for (int i = 0; i < n; ++i) {
+      d[i] = distance(poly[i], p);
+      any_out |= d[i] < 0.0;
+      all_out &= d[i] < 0.0;
+    }
+    if (all_out) return;
+    if (!any_out) continue;
+    int m = 0;
+    for (int i = 0; i < n; ++i) {
+      const int j = (i + 1) % n;
+      if (d[i] >= 0.0) next[m++] = poly[i];
+      if ((d[i] >= 0.0) != (d[j] >= 0.0)) next[m++] = poly[i] + (poly[j] - poly[i]) * (d[i] / (d[i] - d[j]));
+    }
+    n = m;
+    std::copy(next, next + n, poly);
+  }
+  // Project: texel coordinates and the depth key (window depth, negated with reversed-Z).
+  glm::dvec3 s[kMax];
+  for (int i = 0; i < n; ++i) {
+    const glm::dvec4& c = poly[i];
+    const double ndc_z = c.z / c.w;
+    const double depth = clip_.depth == DepthRange::zero_to_one ? ndc_z : ndc_z * 0.5 + 0.5;
+    s[i] = {(c.x / c.w * 0.5 + 0.5) * double(width_), (c.y / c.w * 0.5 + 0.5) * double(height_),
+            clip_.reversed_z ? -depth : depth};
+  }
+  raster_polygon(s, n, count);
+}
+
+void OcclusionBuffer::raster_polygon(const glm::dvec3* in, int n, std::uint32_t& count) {
+  constexpr int kMax = 9;
+  assert(n >= 3 && n <= kMax);
+  // Rule 2: front faces only (counter-clockwise with y up).
+  double area = 0.0;
+  for (int i = 0; i < n; ++i) area += in[i].x * in[(i + 1) % n].y - in[(i + 1) % n].x * in[i].y;
+  glm::dvec3 v[kMax];
+  if (area > 0.0) {
+    std::copy(in, in + n, v);
+  } else {
+    if (rules_.front_faces_only || !(area < 0.0)) return;
+    std::reverse_copy(in, in + n, v);
+  }
+  // Rule 3: vertices snapped to 1/256 texel, edge functions exact in int64.
+  std::int64_t X[kMax], Y[kMax];
+  std::int64_t snapped_area = 0;
+  for (int k = 0; k < n; ++k) {
+    X[k] = std::llround(v[k].x * double(kSub));
+    Y[k] = std::llround(v[k].y * double(kSub));
+  }
+  for (int k = 0; k < n; ++k) snapped_area += X[k] * Y[(k + 1) % n] - X[(k + 1) % n] * Y[k];
+  if (snapped_area <= 0) return;  // degenerate once snapped
+  const std::int64_t min_x = *std::min_element(X, X + n), max_x = *std::max_element(X, X + n);
+  const std::int64_t min_y = *std::min_element(Y, Y + n), max_y = *std::max_element(Y, Y + n);
+  // A polygon narrower than a grown texel on either axis covers none (a
+  // shortcut: the edge functions would find none).
+  const std::int64_t reach = rules_.inner_coverage ? kSub + 2 * kGrow : 0;
+  if (max_x - min_x < reach || max_y - min_y < reach) return;
+  ++count;
+  const auto texel_floor = [](std::int64_t f) { return floor_div(f, kSub); };
+  const int x_lo = int(std::max<std::int64_t>(0, texel_floor(min_x)));
+  const int x_hi = int(std::min<std::int64_t>(width_ - 1, texel_floor(max_x)));
+  const int y_lo = int(std::max<std::int64_t>(0, texel_floor(min_y)));
+  const int y_hi = int(std::min<std::int64_t>(height_ - 1, texel_floor(max_y)));
+  if (x_lo > x_hi || y_lo > y_hi) return;
+
+  // Edge i runs from vertex i to i+1; inside is A*x + B*y + C > 0. The
+  // texel corner each edge is tested at: the one farthest outside it. (A
+  // polygon that snapping left not quite convex is covered where it is
+  // inside every edge: a part of it.)
+  struct Edge {
+    std::int64_t a, b, c, ox, oy;
+  } edges[kMax];
+  int edge_count = 0;
+  for (int i = 0; i < n; ++i) {
+    const int j = (i + 1) % n;
+    if (X[i] == X[j] && Y[i] == Y[j]) continue;  // snapped onto its neighbour
+    Edge& e = edges[edge_count++];
+    e.a = Y[i] - Y[j];
+    e.b = X[j] - X[i];
+    e.c = -(e.a * X[i] + e.b * Y[i]);
+    if (rules_.inner_coverage) {
+      e.ox = e.a > 0 ? -kGrow : kSub + kGrow;
+      e.oy = e.b > 0 ? -kGrow : kSub + kGrow;
+    } else {
+      e.ox = e.oy = kSub / 2;  // the texel's centre (rule 3 broken)
+    }
+  }
+
+  // Rule 4: the depth plane through the three corners spanning the largest
+  // triangle, at the grown texel's farthest corner; the bias covers float
+  // evaluation and the other corners' distance off the plane.
+  int best = 1;
+  double best_area = 0.0;
+  for (int k = 1; k + 1 < n; ++k) {
+    const double a2 = (v[k].x - v[0].x) * (v[k + 1].y - v[0].y) - (v[k + 1].x - v[0].x) * (v[k].y - v[0].y);
+    if (a2 > best_area) best_area = a2, best = k;
+  }
+  const glm::dvec3 p0 = v[0], p1 = v[best], p2 = v[best + 1];
+  const double det = (p1.x - p0.x) * (p2.y - p0.y) - (p2.x - p0.x) * (p1.y - p0.y);
+  if (!(det > 0.0)) return;
+  const double gx = ((p1.z - p0.z) * (p2.y - p0.y) - (p2.z - p0.z) * (p1.y - p0.y)) / det;
+  const double gy = ((p1.x - p0.x) * (p2.z - p0.z) - (p2.x - p0.x) * (p1.z - p0.z)) / det;
+  double z_far = -std::numeric_limits<double>::infinity(), z_near = std::numeric_limits<double>::infinity();
+  double off_plane = 0.0;
+  for (int k = 0; k < n; ++k) {
+    z_far = std::max(z_far, v[k].z);
+    z_near = std::min(z_near, v[k].z);
+    off_plane = std::max(off_plane, std::abs(v[k].z - (p0.z + gx * (v[k].x - p0.x) + gy * (v[k].y - p0.y))));
+  }
+  double fx = 0.5, fy = 0.5, bias = 0.0;
+  float cap = kInf;
+  if (rules_.farthest_depth) {
+    fx = gx > 0.0 ? 1.0 + kGrowTexels : -kGrowTexels;
+    fy = gy > 0.0 ? 1.0 + kGrowTexels : -kGrowTexels;
+    bias = std::ldexp(std::max(std::abs(z_far), std::abs(z_near)) + (z_far - z_near), -20) + off_plane;
+    cap = float(z_far);
+    if (double(cap) < z_far) cap = std::nextafter(cap, kInf);
+  }
+  const float step = float(gx);
+  const bool strict = rules_.inner_coverage;
+
+  // Each edge bounds a row's covered texels on one side: e(tx) = s*tx + r(ty),
+  // s = 256 a, r linear in ty. The bound floor(N/D) (N = -r, D = s when s > 0;
+  // N = r, D = -s when s < 0) is stepped from row to row exactly, quotient
+  // and remainder, with no division per row.
+  struct Bound {
+    int side;  // +1: a lower bound (s > 0), -1: an upper bound (s < 0), 0: the edge is horizontal
+    std::int64_t q, rem, dq, drem, d, r, dr;
+  } bounds[kMax];
+  for (int k = 0; k < edge_count; ++k) {
+    const Edge& e = edges[k];
+    Bound& b = bounds[k];
+    const std::int64_t s = e.a * kSub;
+    b.r = e.a * e.ox + e.b * (std::int64_t(y_lo) * kSub + e.oy) + e.c;
+    b.dr = e.b * kSub;
+    b.side = s > 0 ? 1 : s < 0 ? -1 : 0;
+    if (b.side == 0) continue;
+    b.d = s > 0 ? s : -s;
+    const std::int64_t n0 = s > 0 ? -b.r : b.r, dn = s > 0 ? -b.dr : b.dr;
+    b.q = floor_div(n0, b.d);
+    b.rem = n0 - b.q * b.d;
+    b.dq = floor_div(dn, b.d);
+    b.drem = dn - b.dq * b.d;
+  }
+  for (int ty = y_lo; ty <= y_hi; ++ty) {
+    std::int64_t lo = x_lo, hi = x_hi;
+    for (int k = 0; k < edge_count; ++k) {
+      Bound& b = bounds[k];
+      if (b.side > 0) {  // covered where tx > N/D (>= at centres)
+        lo = std::max(lo, strict ? b.q + 1 : b.q + (b.rem != 0));
+      } else if (b.side < 0) {  // covered where tx < N/D (<= at centres)
+        hi = std::min(hi, strict ? b.q + (b.rem != 0) - 1 : b.q);
+      } else if (strict ? b.r <= 0 : b.r < 0) {
+        lo = hi + 1;
+      }
+      // On to the next row.
+      b.r += b.dr;
+      b.q += b.dq;
+      b.rem += b.drem;
+      if (b.rem >= b.d) b.rem -= b.d, ++b.q;
+    }
+    if (lo > hi) continue;
+    const double base_d = p0.z + gx * (double(lo) + fx - p0.x) + gy * (double(ty) + fy - p0.y) + bias;
+    float base = float(base_d);
+    if (double(base) < base_d) base = std::nextafter(base, kInf);
+    float* row = keys_.data() + std::size_t(ty) * std::size_t(width_) + std::size_t(lo);
+    const int span = int(hi - lo + 1);
+    if (simd_ == SimdPath::best)
+      simd::fill_span(row, span, base, step, cap);
+    else
+      fill_span_scalar(row, span, base, step, cap);
+    std::uint8_t* dirty = tile_dirty_.data() + std::size_t(ty / tile_size) * std::size_t(tiles_x_);
+    for (int t = int(lo) / tile_size; t <= int(hi) / tile_size; ++t) dirty[t] = 1;
+  }
+}
+
+float OcclusionBuffer::tile_farthest(int tx, int ty) {
+  const std::size_t t = std::size_t(ty) * std::size_t(tiles_x_) + std::size_t(tx);
+  if (tile_dirty_[t]) {
+    const int x0 = tx * tile_size, y0 = ty * tile_size;
+    const int w = std::min(tile_size, width_ - x0), h = std::min(tile_size, height_ - y0);
+    float far = -kInf;
+    for (int y = y0; y < y0 + h; ++y) {
+      const float* row = keys_.data() + std::size_t(y) * std::size_t(width_) + std::size_t(x0);
+      const float m = simd_ == SimdPath::best ? simd::max_span(row, w) : max_span_scalar(row, w);
+      far = far > m ? far : m;
+    }
+    tile_far_[t] = far;
+    tile_dirty_[t] = 0;
+  }
+  return tile_far_[t];
+}
+
+bool OcclusionBuffer::occluded(const Aabb& box, const glm::mat4& view_proj) {
+  if (box.empty()) return false;
+  float min_x = kInf, min_y = kInf, max_x = -kInf, max_y = -kInf;
+  float nearest = kInf;
+  int projected = 0;
+  for (int i = 0; i < 8; ++i) {
+    const glm::vec4 c = view_proj * glm::vec4(box.corner(i), 1.0f);
+    const float ndc_z = c.z / c.w;
+    const bool before_near = clip_.reversed_z ? ndc_z > 1.0f : ndc_z < clip_.near_depth();
+    if (c.w <= 0.0f || before_near) {
+      if (rules_.reaching_eye_visible) return false;  // rule 7
+      continue;
+    }
+    ++projected;
+    const float depth = clip_.depth == DepthRange::zero_to_one ? ndc_z : ndc_z * 0.5f + 0.5f;
+    nearest = std::min(nearest, clip_.reversed_z ? -depth : depth);
+    const float px = (c.x / c.w * 0.5f + 0.5f) * float(width_);
+    const float py = (c.y / c.w * 0.5f + 0.5f) * float(height_);
+    min_x = std::min(min_x, px);
+    max_x = std::max(max_x, px);
+    min_y = std::min(min_y, py);
+    max_y = std::max(max_y, py);
+  }
+  if (projected == 0) return false;
+  if (!rules_.nearest_corner) {  // rule 6 broken: the centre's depth
+    const glm::vec4 c = view_proj * glm::vec4(box.center(), 1.0f);
+    const float ndc_z = c.z / c.w;
+    const float depth = clip_.depth == DepthRange::zero_to_one ? ndc_z : ndc_z * 0.5f + 0.5f;
+    nearest = clip_.reversed_z ? -depth : depth;
+  }
+  // Rule 5: every texel the rectangle touches, grown for rounding. (Clamped
+  // as floats first: a corner just past the near plane projects far off.)
+  const auto texel = [](float v, int size) { return int(std::clamp(std::floor(v), -1.0f, float(size))); };
+  constexpr float grow = float(kGrowTexels);
+  int x0, x1, y0, y1;
+  if (rules_.outer_rectangle) {
+    x0 = texel(min_x - grow, width_), x1 = texel(max_x + grow, width_);
+    y0 = texel(min_y - grow, height_), y1 = texel(max_y + grow, height_);
+  } else {  // texels whose centre lies in the rectangle (rule 5 broken)
+    x0 = texel(std::ceil(min_x - 0.5f), width_), x1 = texel(max_x - 0.5f, width_);
+    y0 = texel(std::ceil(min_y - 0.5f), height_), y1 = texel(max_y - 0.5f, height_);
+    if (x0 > x1 || y0 > y1) return true;  // no texel: nothing tested, nothing found visible
+  }
+  if (x1 < 0 || y1 < 0 || x0 >= width_ || y0 >= height_) return false;  // off the buffer: the caller's frustum decides
+  x0 = std::max(x0, 0), y0 = std::max(y0, 0);
+  x1 = std::min(x1, width_ - 1), y1 = std::min(y1, height_ - 1);
+  const bool margin = rules_.depth_margin;
+  for (int ty = y0 / tile_size; ty <= y1 / tile_size; ++ty)
+    for (int tx = x0 / tile_size; tx <= x1 / tile_size; ++tx) {
+      if (behind(nearest, tile_farthest(tx, ty), margin)) continue;  // the whole tile hides the box
+      const int ax = std::max(x0, tx * tile_size), bx = std::min(x1, tx * tile_size + tile_size - 1);
+      const int ay = std::max(y0, ty * tile_size), by = std::min(y1, ty * tile_size + tile_size - 1);
+      for (int y = ay; y <= by; ++y) {
+        const float* row = keys_.data() + std::size_t(y) * std::size_t(width_) + std::size_t(ax);
+        const float far = simd_ == SimdPath::best ? simd::max_span(row, bx - ax + 1) : max_span_scalar(row, bx - ax + 1);
+        if (!behind(nearest, far, margin)) return false;
+      }
+    }
+  return true;
+}
+
+}  // namespace occull

@@ -1,0 +1,327 @@
+// The CPU occlusion buffer's rules (occull/occlusion_buffer.hpp): each test
+// shows a rule keeping a visible box visible, and the same scene with that
+// rule switched off (OcclusionRules) hiding it — a test that cannot fail
+// proves nothing.
+#include "occull/occlusion_buffer.hpp"
+#include "occull/depth_pyramid.hpp"
+#include "occull/view.hpp"
+
+#include <gtest/gtest.h>
+
+#include <bit>
+#include <cmath>
+#include <random>
+
+using namespace occull;
+
+namespace {
+
+// A camera at the origin looking down -Z, 60° vertical, viewport 160×90; the
+// buffer is 16×9 texels, so one texel is 10×10 pixels.
+constexpr int kW = 16, kH = 9;
+constexpr float kTanHalf = 0.57735027f;  // tan(30°)
+constexpr float kAspect = 160.0f / 90.0f;
+
+View camera(DepthMode depth = DepthMode::standard, float near = 0.1f) {
+  return make_view(CameraPose{}, Lens{60.0f, near, 100.0f, depth}, 160, 90);
+}
+
+// The world point at texel coordinates (tx, ty) of the buffer and distance d in front of the eye.
+glm::vec3 at(float tx, float ty, float d) {
+  const float nx = tx / float(kW) * 2.0f - 1.0f, ny = ty / float(kH) * 2.0f - 1.0f;
+  return {nx * d * kTanHalf * kAspect, ny * d * kTanHalf, -d};
+}
+
+struct Polys {
+  std::vector<glm::vec3> positions;
+  std::vector<std::uint32_t> indices;
+  // A rectangle over texels [x0, x1] × [y0, y1] at distances d0 (its left
+  // edge) and d1 (its right edge), facing the eye (or away: `back`), as two triangles.
+  void rect(float x0, float x1, float y0, float y1, float d0, float d1, bool back = false) {
+    const auto base = std::uint32_t(positions.size());
+    positions.insert(positions.end(), {at(x0, y0, d0), at(x1, y0, d1), at(x1, y1, d1), at(x0, y1, d0)});
+    if (back)
+      indices.insert(indices.end(), {base, base + 2, base + 1, base, base + 3, base + 2});
+    else
+      indices.insert(indices.end(), {base, base + 1, base + 2, base, base + 2, base + 3});
+  }
+  void rect(float x0, float x1, float y0, float y1, float d) { rect(x0, x1, y0, y1, d, d); }
+};
+
+// A thin box seen over texels [x0, x1] × [y0, y1] from distance d to d + depth.
+Aabb box(float x0, float x1, float y0, float y1, float d, float depth = 0.01f) {
+  Aabb b;
+  for (float dist : {d, d + depth}) {
+    // At the far distance the same screen rectangle is wider in the world;
+    // the box is the near one's rectangle pushed back (a slab).
+    b.extend(at(x0, y0, d) * (dist / d));
+    b.extend(at(x1, y1, d) * (dist / d));
+  }
+  return b;
+}
+
+struct Fixture {
+  View view;
+  OcclusionBuffer buffer;
+  explicit Fixture(const OcclusionRules& rules = {}, DepthMode depth = DepthMode::standard,
+                   SimdPath simd = SimdPath::best)
+      : view(camera(depth)), buffer(kW, kH, simd, rules) {
+    buffer.clear(view.clip);
+  }
+  // Rasterizes the polygons as soc does: coplanar pairs merged into quads.
+  std::uint32_t draw(const Polys& p) {
+    const OccluderMesh mesh = make_occluder_mesh(p.positions, p.indices);
+    return buffer.rasterize(p.positions, mesh, mesh.polygons(), glm::dmat4(view.view_proj));
+  }
+  bool hidden(const Aabb& b) { return buffer.occluded(b, view.view_proj); }
+};
+
+Polys full_screen(float d) {
+  Polys p;
+  p.rect(-2.0f, 18.0f, -2.0f, 11.0f, d);
+  return p;
+}
+
+}  // namespace
+
+TEST(OcclusionBuffer, ABoxBehindAFullScreenQuadIsHiddenAndOneInFrontIsNot) {
+  Fixture f;
+  EXPECT_EQ(f.draw(full_screen(5.0f)), 1u);
+  EXPECT_EQ(f.buffer.covered_texels(), std::size_t(kW * kH));
+  EXPECT_TRUE(f.hidden(box(3.2f, 4.7f, 2.2f, 3.6f, 10.0f)));
+  EXPECT_FALSE(f.hidden(box(3.2f, 4.7f, 2.2f, 3.6f, 3.0f)));
+}
+
+TEST(OcclusionBuffer, NothingRasterizedHidesNothing) {
+  Fixture f;
+  EXPECT_FALSE(f.hidden(box(3.2f, 4.7f, 2.2f, 3.6f, 10.0f)));
+}
+
+// Rule 3: a gap of 0.3 texel beside the texel's centre, which the left quad covers.
+TEST(OcclusionBuffer, AGapNarrowerThanATexelKeepsWhatIsBehindItVisible) {
+  Polys p;
+  p.rect(-2.0f, 5.6f, -2.0f, 11.0f, 5.0f);
+  p.rect(5.9f, 18.0f, -2.0f, 11.0f, 5.0f);
+  const Aabb behind_gap = box(5.65f, 5.85f, 3.2f, 3.8f, 10.0f);
+  Fixture f;
+  f.draw(p);
+  EXPECT_FALSE(f.hidden(behind_gap));
+  Fixture broken({.inner_coverage = false});
+  broken.draw(p);
+  EXPECT_TRUE(broken.hidden(behind_gap)) << "point-sampled coverage should hide it (the rule's reason)";
+}
+
+TEST(OcclusionBuffer, AnOccluderCoveringHalfATexelCoversNothing) {
+  Fixture f;
+  Polys half;
+  half.rect(3.0f, 3.5f, -2.0f, 11.0f, 5.0f);
+  f.draw(half);
+  EXPECT_EQ(f.buffer.covered_texels(), 0u);
+  Polys one_column;  // texel column 3 with room to spare
+  one_column.rect(2.5f, 4.5f, -2.0f, 11.0f, 5.0f);
+  f.draw(one_column);
+  EXPECT_EQ(f.buffer.covered_texels(), std::size_t(kH));
+  for (int y = 0; y < kH; ++y) EXPECT_NE(f.buffer.key_at(3, y), std::numeric_limits<float>::infinity());
+}
+
+// Rule 4: a wall receding to the right; a box in texel column 7, nearer
+// than the wall at the column's right edge but farther than at its centre.
+TEST(OcclusionBuffer, ASlantedOccluderHidesOnlyWhatIsBehindItsFarthestPoint) {
+  Polys p;
+  p.rect(-2.0f, 18.0f, -2.0f, 11.0f, 2.0f, 20.0f);
+  // The wall's distance along the ray through texel x (y = any): the wall
+  // is the segment from at(-2, ., 2) to at(18, ., 20) in x-z.
+  const auto wall_distance = [](float tx) {
+    const glm::vec3 a = at(-2.0f, 0.0f, 2.0f), b = at(18.0f, 0.0f, 20.0f);
+    const glm::vec3 ray = at(tx, 0.0f, 1.0f);  // z = -1
+    // Solve a + s (b - a) = t ray in x and z.
+    const float det = (b.x - a.x) * (-ray.z) - (b.z - a.z) * (-ray.x);
+    const float t = ((b.x - a.x) * (-a.z) - (b.z - a.z) * (-a.x)) / det;
+    return t;  // distance along -z
+  };
+  const float centre = wall_distance(7.5f), edge = wall_distance(8.0f);
+  ASSERT_LT(centre + 0.05f, edge);
+  const Aabb between = box(7.3f, 7.7f, 3.3f, 3.7f, 0.5f * (centre + edge), 0.01f);
+  Fixture f;
+  f.draw(p);
+  EXPECT_FALSE(f.hidden(between));
+  EXPECT_TRUE(f.hidden(box(7.3f, 7.7f, 3.3f, 3.7f, edge + 0.5f)));
+  Fixture broken({.farthest_depth = false});
+  broken.draw(p);
+  EXPECT_TRUE(broken.hidden(between)) << "the depth at the texel's centre should hide it";
+}
+
+// Rule 5: an occluder over texel columns 0..7; a box reaching 0.3 texel into column 8.
+TEST(OcclusionBuffer, ABoxReachingIntoAnUncoveredTexelIsVisible) {
+  Polys p;
+  p.rect(-2.0f, 8.5f, -2.0f, 11.0f, 5.0f);
+  const Aabb reaching = box(6.2f, 8.3f, 3.2f, 3.8f, 10.0f);
+  Fixture f;
+  f.draw(p);
+  EXPECT_TRUE(f.hidden(box(6.2f, 7.9f, 3.2f, 3.8f, 10.0f)));
+  EXPECT_FALSE(f.hidden(reaching));
+  Fixture broken({.outer_rectangle = false});
+  broken.draw(p);
+  EXPECT_TRUE(broken.hidden(reaching)) << "texels by their centres should miss column 8";
+}
+
+// Rule 6: a box from in front of the occluder to far behind it.
+TEST(OcclusionBuffer, ADeepBoxIsTestedAtItsNearestCorner) {
+  const Aabb deep = box(6.0f, 7.0f, 3.0f, 4.0f, 4.0f, 16.0f);
+  Fixture f;
+  f.draw(full_screen(5.0f));
+  EXPECT_FALSE(f.hidden(deep));
+  Fixture broken({.nearest_corner = false});
+  broken.draw(full_screen(5.0f));
+  EXPECT_TRUE(broken.hidden(deep)) << "the centre's depth should hide it";
+}
+
+// Rule 7: a box from behind the eye to behind the occluder.
+TEST(OcclusionBuffer, ABoxReachingTheEyeIsVisible) {
+  Aabb around_eye;
+  around_eye.extend(glm::vec3(-0.5f, -0.5f, 1.0f));
+  around_eye.extend(glm::vec3(0.5f, 0.5f, -20.0f));
+  Fixture f;
+  f.draw(full_screen(5.0f));
+  EXPECT_FALSE(f.hidden(around_eye));
+  Fixture broken({.reaching_eye_visible = false});
+  broken.draw(full_screen(5.0f));
+  EXPECT_TRUE(broken.hidden(around_eye)) << "its far corners alone should be hidden";
+}
+
+// Rule 8: a box whose nearest key lies behind the texel's by less than the margin.
+TEST(OcclusionBuffer, DepthTiesAreVisible) {
+  Fixture f;
+  f.draw(full_screen(5.0f));
+  const float texel = f.buffer.key_at(6, 3);
+  // The box's nearest key, as occluded() computes it, for a box starting at distance d.
+  const auto key_of = [&](float d) {
+    const glm::vec4 c = f.view.view_proj * glm::vec4(at(6.5f, 3.5f, d), 1.0f);
+    return c.z / c.w * 0.5f + 0.5f;
+  };
+  float lo = 5.0f, hi = 5.5f;  // bisect for a key just behind the texel's, within the margin
+  for (int i = 0; i < 60; ++i) {
+    const float mid = 0.5f * (lo + hi);
+    (key_of(mid) > texel + 0.5f * depth_tolerance(texel) ? hi : lo) = mid;
+  }
+  const float d = hi;
+  ASSERT_GT(key_of(d), texel);
+  const Aabb tie = box(6.3f, 6.7f, 3.3f, 3.7f, d, 0.5f);
+  EXPECT_FALSE(f.hidden(tie));
+  Fixture broken({.depth_margin = false});
+  broken.draw(full_screen(5.0f));
+  EXPECT_TRUE(broken.hidden(tie)) << "with no margin, a key not nearer should be hidden";
+}
+
+TEST(OcclusionBuffer, ReversedZHidesWhatIsBehindOnly) {
+  Fixture f({}, DepthMode::reversed);
+  f.draw(full_screen(5.0f));
+  EXPECT_LT(f.buffer.key_at(4, 4), 0.0f);  // negated reversed depth
+  EXPECT_TRUE(f.hidden(box(3.2f, 4.7f, 2.2f, 3.6f, 10.0f)));
+  EXPECT_FALSE(f.hidden(box(3.2f, 4.7f, 2.2f, 3.6f, 3.0f)));
+}
+
+// Rule 1: an occluder between the eye and the near plane (0.1) is never drawn.
+TEST(OcclusionBuffer, AnOccluderInFrontOfTheNearPlaneHidesNothing) {
+  const Aabb behind = box(3.2f, 4.7f, 2.2f, 3.6f, 10.0f);
+  Fixture f;
+  EXPECT_EQ(f.draw(full_screen(0.05f)), 0u);
+  EXPECT_FALSE(f.hidden(behind));
+  Fixture broken({.clip_near = false});
+  broken.draw(full_screen(0.05f));
+  EXPECT_TRUE(broken.hidden(behind)) << "clipped only at w = 1e-5, it should hide the box";
+}
+
+TEST(OcclusionBuffer, AnOccluderCrossingTheNearPlaneCoversOnlyWhatLiesBeyondIt) {
+  // A floor from behind the eye to far ahead, below the eye: it covers the
+  // lower rows (beyond the near plane) and nothing above the horizon.
+  Fixture f;
+  std::vector<glm::vec3> pos = {{-50, -1, 5}, {50, -1, 5}, {50, -1, -50}, {-50, -1, -50}};
+  std::vector<std::uint32_t> idx = {0, 1, 2, 0, 2, 3};
+  EXPECT_EQ(f.buffer.rasterize(pos, idx, glm::dmat4(f.view.view_proj)), 2u);
+  EXPECT_GT(f.buffer.covered_texels(), 0u);
+  for (int x = 0; x < kW; ++x) EXPECT_EQ(f.buffer.key_at(x, kH - 1), std::numeric_limits<float>::infinity());
+  EXPECT_TRUE(f.hidden(Aabb{{-0.5f, -3.0f, -20.0f}, {0.5f, -2.0f, -19.0f}}));  // under the floor
+}
+
+// Rule 2: the same quad wound the other way.
+TEST(OcclusionBuffer, ABackFacingOccluderHidesNothing) {
+  Polys back;
+  back.rect(-2.0f, 18.0f, -2.0f, 11.0f, 5.0f, 5.0f, true);
+  const Aabb behind = box(3.2f, 4.7f, 2.2f, 3.6f, 10.0f);
+  Fixture f;
+  EXPECT_EQ(f.draw(back), 0u);
+  EXPECT_FALSE(f.hidden(behind));
+  Fixture broken({.front_faces_only = false});
+  broken.draw(back);
+  EXPECT_TRUE(broken.hidden(behind));
+}
+
+TEST(OcclusionBuffer, AQuadAsTwoTrianglesLeavesItsDiagonalUncoveredButMergedCoversIt) {
+  Polys p;
+  p.rect(2.5f, 12.5f, 1.5f, 7.5f, 5.0f);  // texels 3..11 × 2..6 whole
+  Fixture triangles;
+  triangles.buffer.rasterize(p.positions, p.indices, glm::dmat4(triangles.view.view_proj));
+  const OccluderMesh mesh = make_occluder_mesh(p.positions, p.indices);
+  ASSERT_EQ(mesh.polygons(), 1u);
+  EXPECT_NE(mesh.corners[3], OccluderMesh::no_corner);
+  Fixture merged;
+  EXPECT_EQ(merged.buffer.rasterize(p.positions, mesh, 1, glm::dmat4(merged.view.view_proj)), 1u);
+  EXPECT_EQ(merged.buffer.covered_texels(), std::size_t(9 * 5));
+  EXPECT_LT(triangles.buffer.covered_texels(), merged.buffer.covered_texels());
+}
+
+TEST(OcclusionBuffer, OccluderMeshMergesCoplanarConvexPairsAndSortsLargestFirst) {
+  Polys p;
+  p.rect(0.0f, 1.0f, 0.0f, 1.0f, 5.0f);   // a small quad
+  p.rect(4.0f, 12.0f, 0.0f, 8.0f, 5.0f);  // a large one
+  p.positions.insert(p.positions.end(), {at(0, 0, 7), at(3, 0, 7), at(0, 3, 7)});
+  p.indices.insert(p.indices.end(), {8, 9, 10});  // a lone triangle
+  const OccluderMesh mesh = make_occluder_mesh(p.positions, p.indices);
+  ASSERT_EQ(mesh.polygons(), 3u);
+  EXPECT_GE(mesh.inradius[0], mesh.inradius[1]);
+  EXPECT_GE(mesh.inradius[1], mesh.inradius[2]);
+  EXPECT_EQ(mesh.count_at_least(mesh.inradius[1]), 2u);
+  EXPECT_EQ(mesh.count_at_least(0.0f), 3u);
+  EXPECT_EQ(mesh.count_at_least(mesh.inradius[0] * 2.0f), 0u);
+  int quads = 0;
+  for (std::size_t k = 0; k < mesh.polygons(); ++k) quads += mesh.corners[4 * k + 3] != OccluderMesh::no_corner;
+  EXPECT_EQ(quads, 2);
+}
+
+// The vectorised loops equal the scalar reference bit for bit, and so do
+// the answers, over random occluders, sizes and boxes.
+TEST(OcclusionBuffer, SimdMatchesScalar) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<float> u(-4.0f, 20.0f), dist(1.0f, 40.0f);
+  int covered_rounds = 0, hidden_answers = 0;
+  for (int round = 0; round < 40; ++round) {
+    const int w = 1 + int(rng() % 97), h = 1 + int(rng() % 61);
+    const View view = camera(round % 2 ? DepthMode::reversed : DepthMode::standard);
+    OcclusionBuffer best(w, h, SimdPath::best), scalar(w, h, SimdPath::scalar);
+    best.clear(view.clip);
+    scalar.clear(view.clip);
+    Polys p;
+    for (int k = 0; k < 30; ++k) {
+      const float x0 = u(rng), y0 = u(rng) * 0.6f, d0 = dist(rng);
+      p.rect(x0, x0 + std::abs(u(rng)) * 0.5f + 0.2f, y0, y0 + std::abs(u(rng)) * 0.4f + 0.2f, d0, d0 + u(rng) * 0.2f);
+    }
+    const std::uint32_t a = best.rasterize(p.positions, p.indices, glm::dmat4(view.view_proj));
+    const std::uint32_t b = scalar.rasterize(p.positions, p.indices, glm::dmat4(view.view_proj));
+    ASSERT_EQ(a, b);
+    covered_rounds += best.covered_texels() > 0;
+    for (std::size_t i = 0; i < best.keys().size(); ++i)
+      ASSERT_EQ(std::bit_cast<std::uint32_t>(best.keys()[i]), std::bit_cast<std::uint32_t>(scalar.keys()[i]))
+          << "round " << round << " texel " << i;
+    for (int k = 0; k < 50; ++k) {
+      const float x0 = u(rng), y0 = u(rng) * 0.6f;
+      const Aabb b = box(x0, x0 + std::abs(u(rng)) * 0.3f, y0, y0 + 1.0f, dist(rng), 1.0f);
+      const bool hidden = best.occluded(b, view.view_proj);
+      ASSERT_EQ(hidden, scalar.occluded(b, view.view_proj));
+      hidden_answers += hidden;
+    }
+  }
+  EXPECT_GE(covered_rounds, 30);  // the comparison compared something
+  EXPECT_GE(hidden_answers, 50);  // both answers came up
+  EXPECT_FALSE(simd_target_name().empty());
+}
