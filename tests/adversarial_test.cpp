@@ -17,7 +17,7 @@ namespace {
 constexpr int kFrames = 24;
 const char* const kCullers[] = {"stopwait", "chc",  "chcpp", "chcpp:virtual_leaf=0", "nohc", "auto:trial=1:period=2",
                                 "hiz",      "hiz:texels=2", "soc", "soc:scale=1", "soc:width=64:height=36",
-                                "soc:width=173:height=61"};
+                                "soc:width=173:height=61", "chcpp:cpu_test=on", "nohc:cpu_test=on"};
 
 Options fixed_profile() {
   Options o;

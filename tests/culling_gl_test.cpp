@@ -23,7 +23,8 @@ const char* const kConservative[] = {
     "chcpp:multiquery=off", "chcpp:jitter=off", "chcpp:tight=off", "chcpp:virtual_leaf=0", "nohc",
     "auto:trial=1:period=2",  // auto switching every few frames: each candidate returns to stale state
     "hiz", "hiz:texels=2", "hiz:texels=16",
-    "soc", "soc:scale=1", "soc:width=64:height=36", "soc:width=131:height=47", "soc:simd=off"};
+    "soc", "soc:scale=1", "soc:width=64:height=36", "soc:width=131:height=47", "soc:simd=off",
+    "chc:cpu_test=on", "chcpp:cpu_test=on", "nohc:cpu_test=on"};
 
 gl::RendererOptions small_target() { return test::small_target(192, 108); }
 

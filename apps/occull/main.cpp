@@ -26,6 +26,7 @@
 #include "occull/soak.hpp"
 #include "occull/suite.hpp"
 #include "occull/sweep.hpp"
+#include "raster_bench.hpp"
 #include "viewer.hpp"
 
 #include <CLI/CLI.hpp>
@@ -1101,6 +1102,16 @@ int main(int argc, char** argv) {
   up->add_option("--frames", upkeep.frames, "frames")->capture_default_str();
   up->add_option("--seed", upkeep.seed, "random seed")->capture_default_str();
 
+  occull::app::RasterArgs raster;
+  auto* ra = app.add_subcommand("raster",
+                                "time the CPU occlusion buffer's rasterizer (soc) on one core over the occluders a "
+                                "camera path sees: vectorised against the scalar reference, polygons per millisecond");
+  ra->add_option("--scene", raster.scene, "scene spec (see occull scenes)")->capture_default_str();
+  ra->add_option("--path", raster.path, "camera path (default: the scene's first)");
+  ra->add_option("--sizes", raster.sizes, "comma-separated buffer sizes WIDTHxHEIGHT")->capture_default_str();
+  ra->add_option("--frames", raster.frames, "frames spread over the path")->capture_default_str();
+  ra->add_option("--repeat", raster.repeat, "timings of each frame; the fastest counts")->capture_default_str();
+
 #ifdef OCCULL_OSG
   OsgArgs osg_args;
   osg_args.run.report.clear();
@@ -1161,6 +1172,7 @@ int main(int argc, char** argv) {
     if (cmd == "calibrate") return cmd_calibrate(calibrate);
     if (cmd == "traverse") return cmd_traverse(traverse);
     if (cmd == "upkeep") return cmd_upkeep(upkeep);
+    if (cmd == "raster") return occull::app::cmd_raster(raster);
     if (cmd == "soak") return cmd_soak(soak);
     if (cmd == "view") {
       if (!view_size.empty()) {

@@ -77,6 +77,7 @@
 #pragma once
 
 #include "occull/geometry.hpp"
+#include "occull/view.hpp"
 
 #include <glm/mat4x4.hpp>
 
@@ -120,6 +121,16 @@ struct OccluderMesh {
   static constexpr std::uint32_t no_corner = 0xffffffffu;  ///< a triangle's fourth corner
   std::vector<std::uint32_t> corners;  ///< 4 per polygon, counter-clockwise; no_corner last for a triangle
   std::vector<float> inradius;         ///< per polygon, an upper bound (2 area / perimeter), object units, descending
+  /// Per polygon, object space: the plane (unit normal of its counter-clockwise
+  /// side, and offset: n·p = offset on it) and a sphere around its corners.
+  struct Bounds {
+    glm::vec3 normal;
+    float offset;
+    glm::vec3 centre;
+    float radius;
+    float area;  ///< object units squared
+  };
+  std::vector<Bounds> bounds;
   [[nodiscard]] std::size_t polygons() const noexcept { return inradius.size(); }
   /// How many leading polygons have an inradius of at least `radius`.
   [[nodiscard]] std::size_t count_at_least(float radius) const noexcept;
@@ -158,6 +169,22 @@ class OcclusionBuffer {
   /// Returns the polygons rasterized. Precondition: count <= mesh.polygons().
   std::uint32_t rasterize(std::span<const glm::vec3> positions, const OccluderMesh& mesh, std::size_t count,
                           const glm::dmat4& object_to_clip);
+  /// Rasterizes the polygons of an object's `mesh` that can cover a texel
+  /// seen through `view` (its transform `object_to_world`, world box
+  /// `bounds`): polygons_worth_rasterizing(), less those that face away from
+  /// the eye or lie too far from it for their size (tested one by one in
+  /// object space: leaving a polygon out hides nothing). Returns the
+  /// polygons rasterized.
+  std::uint32_t rasterize(std::span<const glm::vec3> positions, const OccluderMesh& mesh, const View& view,
+                          const glm::mat4& object_to_world, const Aabb& bounds);
+
+  /// How many of `mesh`'s leading polygons can cover a texel whole on this
+  /// buffer, for an object with transform `object_to_world` and world box
+  /// `bounds` seen through `view`: those whose inscribed circle, magnified
+  /// as much as the lens can at the box's distance, reaches half a texel.
+  /// The others never cover one (rule 3): leaving them out hides nothing.
+  [[nodiscard]] std::size_t polygons_worth_rasterizing(const OccluderMesh& mesh, const View& view,
+                                                       const glm::mat4& object_to_world, const Aabb& bounds) const;
 
   /// Whether `box` (world space) is hidden behind what was rasterized, seen
   /// through `view_proj` (the same view). False means "may be visible".

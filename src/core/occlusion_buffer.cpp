@@ -45,6 +45,14 @@ std::int64_t floor_div(std::int64_t a, std::int64_t b) {  // b > 0
   return (a % b != 0 && a < 0) ? q - 1 : q;
 }
 
+// A texel coordinate to the nearest 1/256 texel (ties to even), for |v| <
+// 2^20: adding 1.5 * 2^52 leaves no fraction bits in the sum, and the
+// subtraction is exact. No libm call (floor is one on baseline x86-64).
+std::int64_t snap(double v) {
+  constexpr double kMagic = 6755399441055744.0;  // 1.5 * 2^52
+  return std::int64_t((v * double(kSub) + kMagic) - kMagic);
+}
+
 // Rule 8: `nearest` (a box's key) lies behind `farthest` (a texel's or
 // tile's key) by more than depth rounding. +infinity hides nothing.
 bool behind(float nearest, float farthest, bool margin) {
@@ -98,6 +106,7 @@ OccluderMesh make_occluder_mesh(std::span<const glm::vec3> positions, std::span<
   struct Poly {
     std::uint32_t c[4];
     float radius;
+    OccluderMesh::Bounds bounds;
   };
   std::vector<Poly> polys;
   const auto add = [&](const std::uint32_t* c, int n) {
@@ -109,7 +118,16 @@ OccluderMesh make_occluder_mesh(std::span<const glm::vec3> positions, std::span<
       perimeter += glm::length(b - a);
     }
     area2 = glm::length(sum);
-    Poly p{{c[0], c[1], c[2], n == 4 ? c[3] : OccluderMesh::no_corner}, float(area2 / perimeter)};
+    glm::dvec3 centre(0.0);
+    for (int k = 0; k < n; ++k) centre += glm::dvec3(positions[c[k]]);
+    centre /= double(n);
+    double radius = 0.0;
+    for (int k = 0; k < n; ++k) radius = std::max(radius, glm::length(glm::dvec3(positions[c[k]]) - centre));
+    const glm::dvec3 normal = sum / area2;
+    Poly p{{c[0], c[1], c[2], n == 4 ? c[3] : OccluderMesh::no_corner},
+           float(area2 / perimeter),
+           {glm::vec3(normal), float(glm::dot(normal, centre)), glm::vec3(centre), float(radius * (1.0 + 1e-6)),
+            float(0.5 * area2)}};
     polys.push_back(p);
   };
   for (std::size_t t = 0; t < tris.size(); ++t) {
@@ -146,6 +164,7 @@ OccluderMesh make_occluder_mesh(std::span<const glm::vec3> positions, std::span<
   for (const Poly& p : polys) {
     out.corners.insert(out.corners.end(), p.c, p.c + 4);
     out.inradius.push_back(p.radius);
+    out.bounds.push_back(p.bounds);
   }
   return out;
 }
@@ -202,6 +221,46 @@ std::uint32_t OcclusionBuffer::rasterize(std::span<const glm::vec3> positions, c
   return drawn;
 }
 
+std::uint32_t OcclusionBuffer::rasterize(std::span<const glm::vec3> positions, const OccluderMesh& mesh,
+                                         const View& view, const glm::mat4& object_to_world, const Aabb& bounds) {
+  const std::size_t count = polygons_worth_rasterizing(mesh, view, object_to_world, bounds);
+  if (count == 0) return 0;
+  const glm::dmat4 object_to_clip = glm::dmat4(view.view_proj) * glm::dmat4(object_to_world);
+  if (view.orthographic) return rasterize(positions, mesh, count, object_to_clip);
+  // Per polygon, in object space: its side of the eye, its size on the
+  // buffer at its distance (as polygons_worth_rasterizing, per polygon), and
+  // its area seen at its angle, which must hold a circle of half a texel
+  // (pi / 4 texels): a wall seen edge on along a street covers nothing.
+  const glm::dmat3 m(object_to_world);
+  const double flip = glm::determinant(m) < 0.0 ? -1.0 : 1.0;  // a mirroring transform turns the winding
+  const glm::dvec3 eye = glm::dvec3(glm::inverse(glm::dmat4(object_to_world)) * glm::dvec4(glm::dvec3(view.eye), 1.0));
+  const double s0 = glm::length(m[0]), s1 = glm::length(m[1]), s2 = glm::length(m[2]);
+  const double stretch_max = std::max({s0, s1, s2}), stretch_min = std::min({s0, s1, s2});
+  const double fx = std::abs(double(view.proj[0][0])) * 0.5 * double(width_);
+  const double fy = std::abs(double(view.proj[1][1])) * 0.5 * double(height_);
+  const double tan2 = 1.0 / double(view.proj[0][0] * view.proj[0][0]) + 1.0 / double(view.proj[1][1] * view.proj[1][1]);
+  // Texels per object unit at object-space distance d, at most: this / d.
+  const double reach = std::max(fx, fy) * (1.0 + tan2) * stretch_max / std::max(stretch_min, 1e-30);
+  const double near_object = double(view.near) / std::max(stretch_max, 1e-30);
+  std::uint32_t drawn = 0;
+  for (std::size_t p = 0; p < count; ++p) {
+    const OccluderMesh::Bounds& b = mesh.bounds[p];
+    const double side = flip * (glm::dot(glm::dvec3(b.normal), eye) - double(b.offset));
+    if (rules_.front_faces_only && side <= 0.0) continue;
+    const double to_centre = glm::length(eye - glm::dvec3(b.centre));
+    const double d = std::max(to_centre - double(b.radius), near_object);
+    if (double(mesh.inradius[p]) * reach < 0.5 * d) continue;
+    const double cosine = std::min(1.0, std::abs(side) / std::max(to_centre, 1e-30));
+    if (double(b.area) * cosine * (reach / d) * (reach / d) < 0.785) continue;
+    const std::uint32_t* corners = mesh.corners.data() + 4 * p;
+    const int n = corners[3] == OccluderMesh::no_corner ? 3 : 4;
+    glm::dvec4 c[4];
+    for (int k = 0; k < n; ++k) c[k] = object_to_clip * glm::dvec4(glm::dvec3(positions[corners[k]]), 1.0);
+    raster_clipped(c, n, drawn);
+  }
+  return drawn;
+}
+
 // Rule 1: clips a convex polygon at the near plane and the guard band (in
 // double, Sutherland-Hodgman), then rasterizes what is left.
 void OcclusionBuffer::raster_clipped(const glm::dvec4* clip, int vertices, std::uint32_t& count) {
@@ -222,6 +281,24 @@ void OcclusionBuffer::raster_clipped(const glm::dvec4* clip, int vertices, std::
   };
   constexpr int kPlanes = 5;
   constexpr int kMax = 4 + kPlanes;
+  // Shortcuts that change no texel: a polygon wholly past one side of the
+  // viewport is dropped, and so is a back-facing one lying wholly beyond
+  // the near plane (its orientation on screen is the sign of det[x y w] of
+  // three corners when every w > 0; a polygon's corners are coplanar).
+  {
+    unsigned all_out = 0xf, crossing_near = 0;
+    for (int i = 0; i < vertices; ++i) {
+      const glm::dvec4& c = clip[i];
+      all_out &= unsigned(c.x > c.w) | unsigned(c.x < -c.w) << 1 | unsigned(c.y > c.w) << 2 | unsigned(c.y < -c.w) << 3;
+      crossing_near |= unsigned(!(distance(c, 0) >= 0.0) || !(c.w > 0.0));
+    }
+    if (all_out != 0) return;
+    if (!crossing_near && rules_.front_faces_only) {
+      const glm::dvec3 a(clip[0].x, clip[0].y, clip[0].w), b(clip[1].x, clip[1].y, clip[1].w),
+          c(clip[2].x, clip[2].y, clip[2].w);
+      if (!(glm::dot(a, glm::cross(b, c)) > 0.0)) return;
+    }
+  }
   glm::dvec4 poly[kMax], next[kMax];
   int n = vertices;
   std::copy(clip, clip + n, poly);
@@ -273,8 +350,8 @@ void OcclusionBuffer::raster_polygon(const glm::dvec3* in, int n, std::uint32_t&
   std::int64_t X[kMax], Y[kMax];
   std::int64_t snapped_area = 0;
   for (int k = 0; k < n; ++k) {
-    X[k] = std::llround(v[k].x * double(kSub));
-    Y[k] = std::llround(v[k].y * double(kSub));
+    X[k] = snap(v[k].x);
+    Y[k] = snap(v[k].y);
   }
   for (int k = 0; k < n; ++k) snapped_area += X[k] * Y[(k + 1) % n] - X[(k + 1) % n] * Y[k];
   if (snapped_area <= 0) return;  // degenerate once snapped
@@ -401,6 +478,23 @@ void OcclusionBuffer::raster_polygon(const glm::dvec3* in, int n, std::uint32_t&
     std::uint8_t* dirty = tile_dirty_.data() + std::size_t(ty / tile_size) * std::size_t(tiles_x_);
     for (int t = int(lo) / tile_size; t <= int(hi) / tile_size; ++t) dirty[t] = 1;
   }
+}
+
+std::size_t OcclusionBuffer::polygons_worth_rasterizing(const OccluderMesh& mesh, const View& view,
+                                                        const glm::mat4& object_to_world, const Aabb& bounds) const {
+  // Texels per unit at unit view depth, times 1 + tan^2 of the lens's half
+  // angles: off axis a length grows by up to that, and a point at distance
+  // d lies at a view depth of at least d / sqrt(1 + tan^2).
+  const double fx = std::abs(double(view.proj[0][0])) * 0.5 * double(width_);
+  const double fy = std::abs(double(view.proj[1][1])) * 0.5 * double(height_);
+  const double tan2 = view.orthographic ? 0.0
+                                        : 1.0 / double(view.proj[0][0] * view.proj[0][0]) +
+                                              1.0 / double(view.proj[1][1] * view.proj[1][1]);
+  const glm::mat3 m(object_to_world);
+  const double stretch = std::max({glm::length(m[0]), glm::length(m[1]), glm::length(m[2])});
+  const double depth = view.orthographic ? 1.0 : std::max(double(distance(view.eye, bounds)), double(view.near));
+  const double texels_per_unit = stretch * std::max(fx, fy) * (1.0 + tan2) / depth;
+  return mesh.count_at_least(float(0.5 / texels_per_unit));
 }
 
 float OcclusionBuffer::tile_farthest(int tx, int ty) {

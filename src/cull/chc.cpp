@@ -33,9 +33,15 @@ struct ChcConfig {
 class ChcCuller final : public Culler {
  public:
   ChcCuller(const SceneIndex& index, const ChcConfig& c)
-      : index_(index), common_(c.common), skip_(c.skip), state_(index.bvh.size()), submitter_(c.flush_every) {}
+      : index_(index), common_(c.common), cpu_test_(make_cpu_test(index, c.common)), skip_(c.skip), state_(index.bvh.size()), submitter_(c.flush_every) {}
 
   FrameStats cull(const View& view, Backend& backend) override {
+    return cull_with_cpu_test(cpu_test_.get(), view, backend,
+                              [this](const View& v, Backend& b) { return cull_frame(v, b); });
+  }
+
+ private:
+  FrameStats cull_frame(const View& view, Backend& backend) {
     ++frame_;
     seen_.begin(index_.scene);
     if (seen_.rebuilt(index_.bvh)) carry_over(state_, index_.bvh, seen_, frame_ - 1);
@@ -121,6 +127,7 @@ class ChcCuller final : public Culler {
 
   SceneIndex index_;
   CommonOptions common_;
+  std::unique_ptr<CpuTestBackend> cpu_test_;
   std::uint32_t skip_;
   std::vector<NodeState> state_;
   ObjectVisibility seen_;  // what was drawn, for state_ after a rebuild of the hierarchy

@@ -115,6 +115,12 @@ class ChcppCuller final : public Culler {
         state_(index.bvh.size()), random_(config.seed), gate_(reset_nodes(), config.enter_p_min) {}
 
   FrameStats cull(const View& view, Backend& backend) override {
+    return cull_with_cpu_test(cpu_test_.get(), view, backend,
+                              [this](const View& v, Backend& b) { return cull_frame(v, b); });
+  }
+
+ private:
+  FrameStats cull_frame(const View& view, Backend& backend) {
     ++frame_;
     seen_.begin(index_.scene);
     if (seen_.rebuilt(index_.bvh)) {
@@ -382,6 +388,7 @@ class ChcppCuller final : public Culler {
 
   SceneIndex index_;
   ChcppConfig config_;
+  std::unique_ptr<CpuTestBackend> cpu_test_ = make_cpu_test(index_, config_.common);
   VisibilityPersistence persistence_;
   std::vector<NodeState> state_;
   ObjectVisibility seen_;  // what was drawn, for state_ after a rebuild of the hierarchy

@@ -104,6 +104,12 @@ class NohcCuller final : public Culler {
   }
 
   FrameStats cull(const View& view, Backend& backend) override {
+    return cull_with_cpu_test(cpu_test_.get(), view, backend,
+                              [this](const View& v, Backend& b) { return cull_frame(v, b); });
+  }
+
+ private:
+  FrameStats cull_frame(const View& view, Backend& backend) {
     ++frame_;
     // A rebuilt hierarchy starts from what was drawn last frame (carry_over;
     // conservative whatever it says: only queries cull); a changed set of
@@ -349,6 +355,7 @@ class NohcCuller final : public Culler {
 
   SceneIndex index_;
   NohcConfig config_;
+  std::unique_ptr<CpuTestBackend> cpu_test_ = make_cpu_test(index_, config_.common);
   HardwareProfile hw_;
   std::vector<NodeInfo> nodes_;
   double levels_ = 1.0;

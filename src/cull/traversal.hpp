@@ -5,10 +5,12 @@
 
 #include "occull/bvh.hpp"
 #include "config_table.hpp"
+#include "occull/cpu_test_backend.hpp"
 #include "occull/culler.hpp"
 
 #include <array>
 #include <cstdint>
+#include <memory>
 #include <queue>
 #include <vector>
 
@@ -254,7 +256,23 @@ inline void append_query_boxes(const SceneIndex& index, NodeId n, const QuerySha
 struct CommonOptions {
   std::uint64_t threshold = 0;           ///< a node is visible when more samples pass
   std::uint32_t virtual_leaf_triangles = 0;
+  bool cpu_test = false;                 ///< ask a CPU occlusion buffer before each query (CpuTestBackend)
 };
+
+/// The CPU first test a culler with these options runs its frames through, or null.
+inline std::unique_ptr<CpuTestBackend> make_cpu_test(const SceneIndex& index, const CommonOptions& options) {
+  return options.cpu_test ? std::make_unique<CpuTestBackend>(index.scene) : nullptr;
+}
+
+/// Runs `cull(view, backend)`, through `test` (the CPU first test) when it is set.
+template <class F>
+FrameStats cull_with_cpu_test(CpuTestBackend* test, const View& view, Backend& backend, F&& cull) {
+  if (!test) return cull(view, backend);
+  test->begin_frame(backend, view);
+  FrameStats stats = cull(view, static_cast<Backend&>(*test));
+  test->end_frame(stats);
+  return stats;
+}
 
 /// Adds the fields of the CommonOptions at `at` (see ConfigTable) to `table`.
 template <class Config, class At>
@@ -264,7 +282,10 @@ ConfigTable<Config>&& with_common_options(ConfigTable<Config>&& table, At at) {
                "a node is visible when more samples (pixels) pass")
       .approximate_unless_default()
       .integer("virtual_leaf", [at](auto& c) -> auto& { return std::invoke(at, c).virtual_leaf_triangles; }, 0,
-               1 << 30, "subtrees with at most this many triangles count as leaves (0: off)");
+               1 << 30, "subtrees with at most this many triangles count as leaves (0: off)")
+      .flag("cpu_test", [at](auto& c) -> auto& { return std::invoke(at, c).cpu_test; },
+            "ask a conservative CPU occlusion buffer of the occluders drawn so far before each query; issue it only "
+            "when the buffer cannot prove the boxes hidden (CpuTestBackend)");
 }
 
 }  // namespace occull::detail

@@ -1,0 +1,111 @@
+// `occull raster`: times OcclusionBuffer::rasterize on one core over the
+// occluders a camera path sees, as soc would rasterize them (the polygons
+// that can cover a texel from where the camera is), with the vectorised
+// inner loops and with the scalar reference. Buffers are cleared between
+// frames, nothing is tested: this is the rasterizer's throughput alone.
+#include "raster_bench.hpp"
+
+#include "occull/error.hpp"
+#include "occull/input_limits.hpp"
+#include "occull/occlusion_buffer.hpp"
+#include "occull/scenes.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <map>
+#include <vector>
+
+namespace occull::app {
+namespace {
+
+struct Job {
+  const Mesh* mesh;
+  const OccluderMesh* occluder;
+  const Object* object;
+};
+
+}  // namespace
+
+int cmd_raster(const RasterArgs& a) {
+  if (a.frames < 1) throw InputError("--frames must be at least 1");
+  if (a.repeat < 1) throw InputError("--repeat must be at least 1");
+  std::vector<std::pair<int, int>> sizes;
+  std::size_t pos = 0;
+  while (pos <= a.sizes.size()) {
+    const std::size_t comma = std::min(a.sizes.find(',', pos), a.sizes.size());
+    const std::string item = a.sizes.substr(pos, comma - pos);
+    int w = 0, h = 0;
+    char x = 0, extra = 0;
+    if (std::sscanf(item.c_str(), "%d%c%d%c", &w, &x, &h, &extra) != 3 || (x != 'x' && x != 'X') || w < 1 ||
+        h < 1 || w > 8192 || h > 8192)
+      throw InputError(fmt::format("--sizes: '{}' is not WIDTHxHEIGHT with sides in [1, 8192]", item));
+    sizes.emplace_back(w, h);
+    pos = comma + 1;
+  }
+  SceneBundle bundle = make_scene(a.scene);
+  if (bundle.world) throw InputError("occull raster runs on scenes with a BVH, not on tiled worlds");
+  const CameraPath& path = a.path.empty() ? bundle.paths.front() : bundle.path(a.path);
+  Scene& scene = bundle.scene;
+  std::map<MeshId, OccluderMesh> occluders;
+  for (const Object& o : scene.objects())
+    if (!o.removed && o.occluder != OccluderClass::never && !scene.material(o.material).translucent &&
+        !scene.mesh(o.mesh).positions.empty() && !occluders.count(o.mesh))
+      occluders.emplace(o.mesh, make_occluder_mesh(scene.mesh(o.mesh).positions, scene.mesh(o.mesh).indices));
+
+  fmt::print("scene {}, path {}, {} frames spread over the path, best of {} timings each; one core; "
+             "SIMD: {}\n",
+             a.scene, path.name(), a.frames, a.repeat, simd_target_name());
+  fmt::print("{:>10} {:>9} {:>9} {:>12} {:>12} {:>12} {:>12} {:>8}\n", "buffer", "submitted", "polygons", "simd ms", "scalar ms",
+             "simd p/ms", "scalar p/ms", "ratio");
+  using Clock = std::chrono::steady_clock;
+  for (const auto& [w, h] : sizes) {
+    OcclusionBuffer best(w, h, SimdPath::best), scalar(w, h, SimdPath::scalar);
+    double t_best = 0.0, t_scalar = 0.0;
+    std::uint64_t polygons = 0, submitted = 0;
+    std::vector<Job> jobs;
+    for (int k = 0; k < a.frames; ++k) {
+      const double t = path.frame_time(k, a.frames);
+      scene.update(t);
+      const View view = make_view(path.sample(t), bundle.lens, w, h);
+      jobs.clear();
+      for (const Object& o : scene.objects()) {
+        const auto it = occluders.find(o.mesh);
+        if (it == occluders.end() || o.removed || o.occluder == OccluderClass::never ||
+            view.frustum.classify(o.bounds) == Containment::outside)
+          continue;
+        const std::size_t count = best.polygons_worth_rasterizing(it->second, view, o.transform, o.bounds);
+        submitted += count;
+        if (count > 0)
+          jobs.push_back({&scene.mesh(o.mesh), &it->second, &o});
+      }
+      for (auto [buffer, total] : {std::pair{&best, &t_best}, std::pair{&scalar, &t_scalar}}) {
+        double fastest = 1e30;
+        std::uint64_t drawn = 0;
+        for (int r = 0; r < a.repeat; ++r) {
+          buffer->clear(view.clip);
+          drawn = 0;
+          const auto start = Clock::now();
+          for (const Job& j : jobs)
+            drawn += buffer->rasterize(j.mesh->positions, *j.occluder, view, j.object->transform, j.object->bounds);
+          fastest = std::min(fastest, std::chrono::duration<double, std::milli>(Clock::now() - start).count());
+        }
+        *total += fastest;
+        if (buffer == &best) polygons += drawn;
+      }
+      if (!std::equal(best.keys().begin(), best.keys().end(), scalar.keys().begin()))
+        throw std::logic_error("occull raster: the vectorised buffer differs from the scalar reference");
+    }
+    fmt::print("{:>10} {:>9.0f} {:>9.0f} {:>12.4f} {:>12.4f} {:>12.0f} {:>12.0f} {:>7.2f}x\n", fmt::format("{}x{}", w, h),
+               double(submitted) / a.frames, double(polygons) / a.frames, t_best / a.frames, t_scalar / a.frames, double(polygons) / t_best,
+               double(polygons) / t_scalar, t_scalar / t_best);
+  }
+  fmt::print("submitted: polygons of the occluders in the frustum that could cover a texel from where the camera is; "
+             "polygons: rasterized per frame (front-facing, in the buffer, wide enough to cover a texel); ms: per "
+             "frame; p/ms: polygons per millisecond\n");
+  return 0;
+}
+
+}  // namespace occull::app

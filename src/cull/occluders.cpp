@@ -1,0 +1,46 @@
+#include "occluders.hpp"
+
+#include <chrono>
+#include <cmath>
+
+namespace occull::detail {
+
+Occluders::Occluders(const Scene& scene, const OccluderChoice& choice) : scene_(scene), choice_(choice) {
+  for (const Object& o : scene.objects())
+    if (o.occluder != OccluderClass::never && !o.removed) (void)occluder_of(o.mesh);
+}
+
+void Occluders::begin_frame(const View& view, const OcclusionBuffer& buffer) {
+  // Texels per scene unit of radius at unit distance (orthographic: at any distance).
+  texel_scale_ = std::abs(double(view.proj[1][1])) * 0.5 * double(buffer.height());
+  sometimes_left_ = std::uint64_t(choice_.budget);
+}
+
+void Occluders::rasterize_if_occluder(OcclusionBuffer& buffer, ObjectId id, const View& view, FrameStats& stats) {
+  const Object& o = scene_.object(id);
+  if (o.removed || o.occluder == OccluderClass::never || scene_.material(o.material).translucent) return;
+  const Mesh& mesh = scene_.mesh(o.mesh);
+  if (mesh.positions.empty()) return;  // the engine keeps its vertices: nothing to rasterize
+  if (o.occluder == OccluderClass::sometimes && o.triangles > sometimes_left_) return;
+  // How many texels across the box's bounding sphere spans: a smaller
+  // occluder covers next to no texel whole (rule 3), and costs its polygons.
+  const double radius = 0.5 * double(glm::length(o.bounds.extent()));
+  const double distance = view.orthographic ? 1.0 : std::max(double(glm::length(o.bounds.center() - view.eye)), 1e-6);
+  if (2.0 * radius * texel_scale_ / distance < choice_.min_texels) return;
+  const auto start = std::chrono::steady_clock::now();
+  const std::uint32_t drawn = buffer.rasterize(mesh.positions, occluder_of(o.mesh), view, o.transform, o.bounds);
+  stats.raster_ms += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  stats.occluder_triangles += drawn;
+  if (o.occluder == OccluderClass::sometimes) sometimes_left_ -= o.triangles;
+}
+
+const OccluderMesh& Occluders::occluder_of(MeshId mesh) {
+  if (meshes_.size() <= mesh) meshes_.resize(std::size_t(mesh) + 1);
+  if (!meshes_[mesh]) {
+    const Mesh& m = scene_.mesh(mesh);
+    meshes_[mesh] = make_occluder_mesh(m.positions, m.indices);
+  }
+  return *meshes_[mesh];
+}
+
+}  // namespace occull::detail

@@ -1,0 +1,150 @@
+// The CPU first test (CpuTestBackend) and `soc` with a scripted Backend:
+// what they answer, forward and draw.
+#include "occull/bvh.hpp"
+#include "occull/cpu_test_backend.hpp"
+#include "occull/culler.hpp"
+#include "test_util.hpp"
+
+#include <gtest/gtest.h>
+
+using namespace occull;
+using test::ScriptedBackend;
+
+namespace {
+
+// A wall 10 m down -Z filling the view, a box behind it, a box beside the
+// eye in front of it; the camera at the origin looking down -Z.
+Scene wall_scene() {
+  return test::box_scene({{{-40, -40, -11}, {40, 40, -10}},   // 0: the wall
+                          {{-1, -1, -30}, {1, 1, -28}},       // 1: behind it
+                          {{-1, -1, -6}, {1, 1, -5}}});        // 2: in front of it
+}
+
+View camera() { return make_view(CameraPose{}, Lens{60.0f, 0.1f, 100.0f}, 320, 180); }
+
+TEST(CpuTestBackend, AQueryOfBoxesBehindADrawnOccluderIsAnsweredWithoutTheDevice) {
+  const Scene scene = wall_scene();
+  const View view = camera();
+  ScriptedBackend device;
+  CpuTestBackend test(scene);
+  test.begin_frame(device, view);
+  const ObjectId wall = 0;
+  test.render(std::span(&wall, 1));
+  EXPECT_EQ(device.rendered, std::vector<ObjectId>{0});
+  const Aabb behind[] = {scene.object(1).bounds};
+  const QueryId q = test.issue_query(behind);
+  EXPECT_TRUE(device.queried.empty());
+  EXPECT_TRUE(test.result_available(q));
+  EXPECT_EQ(test.result(q), 0u);
+  EXPECT_EQ(test.answered(), 1u);
+  // In front of the wall, or with one box in front: the device is asked.
+  const Aabb mixed[] = {scene.object(1).bounds, scene.object(2).bounds};
+  const QueryId r = test.issue_query(mixed);
+  ASSERT_EQ(device.queried.size(), 1u);
+  EXPECT_EQ(device.queried[0].size(), 2u);
+  EXPECT_EQ(test.result(r), 2u);  // the scripted device's answer, passed on
+  FrameStats stats;
+  test.end_frame(stats);
+  EXPECT_GT(stats.occluder_triangles, 0u);
+  EXPECT_EQ(stats.boxes_tested, 3u);  // the hidden one, then the first of the two
+  EXPECT_EQ(stats.buffer_texels, 80u * 45u);
+}
+
+TEST(CpuTestBackend, NothingDrawnYetMeansEveryQueryGoesToTheDevice) {
+  const Scene scene = wall_scene();
+  const View view = camera();
+  ScriptedBackend device;
+  CpuTestBackend test(scene);
+  test.begin_frame(device, view);
+  const Aabb behind[] = {scene.object(1).bounds};
+  (void)test.result(test.issue_query(behind));
+  EXPECT_EQ(device.queried.size(), 1u);
+  // Drawn under a condition, the wall may not be drawn at all: it occludes nothing.
+  device.conditional = true;
+  const QueryId q = test.issue_query(behind);
+  const ObjectId wall = 0;
+  test.render_conditional(std::span(&wall, 1), q, ConditionalWait::wait);
+  (void)test.result(q);
+  (void)test.result(test.issue_query(behind));
+  EXPECT_EQ(device.queried.size(), 3u);
+  EXPECT_EQ(test.answered(), 0u);
+}
+
+TEST(CpuTestBackend, EachFrameStartsWithAnEmptyBuffer) {
+  const Scene scene = wall_scene();
+  const View view = camera();
+  ScriptedBackend device;
+  CpuTestBackend test(scene);
+  test.begin_frame(device, view);
+  const ObjectId wall = 0;
+  test.render(std::span(&wall, 1));
+  const Aabb behind[] = {scene.object(1).bounds};
+  (void)test.result(test.issue_query(behind));
+  EXPECT_EQ(test.answered(), 1u);
+  FrameStats stats;
+  test.end_frame(stats);
+  test.begin_frame(device, view);
+  (void)test.result(test.issue_query(behind));
+  EXPECT_EQ(test.answered(), 0u);
+  EXPECT_EQ(device.queried.size(), 1u);
+}
+
+TEST(CpuTestBackend, ChcppWithTheFirstTestIssuesFewerQueriesAndDrawsTheSame) {
+  // The wall, and 40 boxes behind it in a row: a hierarchy of hidden nodes.
+  std::vector<Aabb> boxes = {{{-40, -40, -11}, {40, 40, -10}}};
+  for (int i = 0; i < 40; ++i) boxes.push_back({{-20.0f + float(i), -1, -30}, {-19.5f + float(i), 1, -28}});
+  const Scene scene = test::box_scene(boxes);
+  const Bvh bvh = Bvh::build(scene);
+  const View view = camera();
+  std::vector<ObjectId> drawn[2];
+  std::size_t queries[2];
+  for (int on = 0; on < 2; ++on) {
+    ScriptedBackend device;
+    // The device reports no sample for the box behind the wall, as a GPU would.
+    device.visible_samples = [&](std::span<const Aabb> boxes) {
+      std::uint64_t n = 0;
+      for (const Aabb& b : boxes) n += b.max.z > -12.0f ? 1 : 0;
+      return n;
+    };
+    // (virtual_leaf=0: the whole scene is under chcpp's default virtual leaf size)
+    auto culler = make_culler(on ? "chcpp:virtual_leaf=0:cpu_test=on" : "chcpp:virtual_leaf=0", {scene, bvh});
+    for (int frame = 0; frame < 6; ++frame) {
+      device.rendered.clear();
+      (void)culler->render_frame(view, device);
+    }
+    drawn[on] = device.rendered;
+    queries[on] = device.queried.size();
+    std::sort(drawn[on].begin(), drawn[on].end());
+  }
+  EXPECT_EQ(drawn[0], drawn[1]);
+  EXPECT_LT(queries[1], queries[0]);
+}
+
+TEST(Soc, DrawsTheWallAndWhatIsInFrontOfItButNotWhatIsBehind) {
+  const Scene scene = wall_scene();
+  const Bvh bvh = Bvh::build(scene);
+  ScriptedBackend device;
+  auto soc = make_culler("soc", {scene, bvh});
+  const FrameStats stats = soc->render_frame(camera(), device);
+  std::sort(device.rendered.begin(), device.rendered.end());
+  EXPECT_EQ(device.rendered, (std::vector<ObjectId>{0, 2}));
+  EXPECT_TRUE(device.queried.empty());
+  EXPECT_GT(stats.occluder_triangles, 0u);
+  EXPECT_GT(stats.boxes_tested, 0u);
+}
+
+TEST(Soc, AnOccluderWithoutVerticesOnTheCpuHidesNothing) {
+  Scene scene("info");
+  const MaterialId mat = scene.add_material({"grey", {0.7f, 0.7f, 0.7f, 1.0f}, false, 0});
+  const MeshId wall = scene.add_mesh(MeshInfo{{{-40, -40, -11}, {40, 40, -10}}, 12, 6400.0});
+  const MeshId box = scene.add_mesh(MeshInfo{{{-1, -1, -30}, {1, 1, -28}}, 12, 24.0});
+  scene.add_object(wall, mat, glm::mat4(1.0f), OccluderClass::always);
+  scene.add_object(box, mat, glm::mat4(1.0f), OccluderClass::always);
+  const Bvh bvh = Bvh::build(scene);
+  ScriptedBackend device;
+  auto soc = make_culler("soc", {scene, bvh});
+  (void)soc->render_frame(camera(), device);
+  EXPECT_EQ(device.rendered.size(), 2u);
+}
+
+}  // namespace
