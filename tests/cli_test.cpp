@@ -54,7 +54,8 @@ enum Column { kMean = 1, kMedian, kP95, kMax, kVsVfc, kVsOracle, kQueries, kStat
 
 TEST(Cli, HelpOnEveryCommandNamesItsOptions) {
   const std::vector<std::pair<std::string, std::vector<std::string>>> commands = {
-      {"", {"bench", "sweep", "calibrate", "render", "scenes", "algos", "info", "path", "traverse", "soak", "Exit codes"}},
+      {"", {"bench", "sweep", "calibrate", "render", "scenes", "algos", "info", "path", "traverse", "raster", "soak",
+            "Exit codes"}},
       {"info", {"--help"}},
       {"scenes", {"--list-maps"}},
       {"algos", {"--help"}},
@@ -64,8 +65,9 @@ TEST(Cli, HelpOnEveryCommandNamesItsOptions) {
                  "--suite", "--malloc", "--views", "--gl-debug", "--stall-guard", "--watchdog"}},
       {"calibrate", {"--size", "--repeats", "--out", "--check"}},
       {"sweep", {"--algo", "--vary", "--baseline", "--popping", "--longest", "--scene", "--frames", "--json"}},
-      {"render", {"--scene", "--frame", "--fps", "--out", "--png", "--view", "overview", "--gl-debug"}},
+      {"render", {"--scene", "--frame", "--fps", "--out", "--png", "--view", "overview", "soc:", "--gl-debug"}},
       {"traverse", {"--dims", "--views", "--mode", "--fov", "--seed"}},
+      {"raster", {"--scene", "--path", "--sizes", "--frames", "--repeat"}},
       {"soak", {"--scene", "--path", "--algo", "--frames", "--window", "--warmup", "--fps", "--size", "--json",
                 "--gl-debug", "--stall-guard", "--watchdog"}}};
   for (const auto& [cmd, options] : commands) {
@@ -230,6 +232,32 @@ TEST(Cli, RenderTakesTheAlgorithmSpecsBenchTakes) {
   r = run(std::string("render ") + kTinyCity + " --algo oracle --out /dev/null");
   EXPECT_EQ(r.code, 2) << r.output;
   EXPECT_NE(r.output.find("ground truth"), std::string::npos) << r.output;
+}
+
+TEST(Cli, RenderShowsTheOcclusionBufferBesideTheFrame) {
+  const std::string out = ::testing::TempDir() + "occull_cli_soc.png";
+  std::remove(out.c_str());
+  CliRun r = run(std::string("render ") + kTinyCity + " --algo soc --view soc --frame 2 --frames 5 --out " + out);
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("(128x48)"), std::string::npos) << r.output;  // the frame and the buffer, side by side
+  EXPECT_NE(r.output.find("the occlusion buffer, 16x12 texels"), std::string::npos) << r.output;
+  EXPECT_TRUE(std::filesystem::exists(out));
+  r = run(std::string("render ") + kTinyCity + " --algo chcpp:cpu_test=on --view soc --frame 2 --frames 5 --out /dev/null");
+  EXPECT_EQ(r.code, 0) << r.output;
+  r = run(std::string("render ") + kTinyCity + " --algo chcpp --view soc --out /dev/null");
+  EXPECT_EQ(r.code, 2) << r.output;
+  EXPECT_NE(r.output.find("cpu_test=on"), std::string::npos) << r.output;
+}
+
+TEST(Cli, RasterTimesTheRasterizerAndRefusesABadSize) {
+  CliRun r = run("raster --scene city:blocks=3 --frames 2 --repeat 1 --sizes 64x36,100x50");
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("64x36"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("100x50"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("SIMD: "), std::string::npos) << r.output;
+  r = run("raster --sizes 64by36");
+  EXPECT_EQ(r.code, 2) << r.output;
+  EXPECT_NE(r.output.find("64by36"), std::string::npos) << r.output;
 }
 
 TEST(Cli, RenderRefusesAViewTheAlgorithmHasNot) {

@@ -623,7 +623,9 @@ int cmd_render(const RenderArgs& a) {
   const Size size = parse_size(a.size);
   if (a.frames < 1) throw occull::InputError("--frames must be at least 1");
   const auto [first, last] = parse_frame_range(a.frame, a.frames);
-  const occull::DebugView view = occull::parse_debug_view(a.view);
+  // `soc`: the frame with the CPU occlusion buffer the culler used beside it.
+  const bool buffer_view = a.view == "soc";
+  const occull::DebugView view = buffer_view ? occull::DebugView::color : occull::parse_debug_view(a.view);
   const occull::Options options = parse_options(a.opts);
   occull::gl::RendererOptions ropts;
   ropts.width = size.width;
@@ -676,11 +678,30 @@ int cmd_render(const RenderArgs& a) {
         legend += fmt::format("\n  {:>6}  {} (rgb {:.2f} {:.2f} {:.2f})", l.count, l.label, l.color.r, l.color.g,
                               l.color.b);
     }
+    int image_width = size.width;
+    if (buffer_view) {
+      const occull::OcclusionBuffer* buffer = culler->occlusion_buffer();
+      if (!buffer)
+        throw occull::InputError(fmt::format("--view soc shows a CPU occlusion buffer and {} has none: use --algo soc, "
+                                             "or chc, chcpp or nohc with cpu_test=on",
+                                             algo));
+      const std::vector<std::uint8_t> right = occull::occlusion_buffer_rgba(*buffer, size.width, size.height);
+      std::vector<std::uint8_t> both(pixels.size() * 2);
+      const std::size_t row = std::size_t(size.width) * 4;
+      for (int y = 0; y < size.height; ++y) {
+        std::copy_n(pixels.data() + std::size_t(y) * row, row, both.data() + std::size_t(y) * 2 * row);
+        std::copy_n(right.data() + std::size_t(y) * row, row, both.data() + std::size_t(y) * 2 * row + row);
+      }
+      pixels = std::move(both);
+      image_width = 2 * size.width;
+      legend = fmt::format("\n  right: the occlusion buffer, {}x{} texels, {} covered (nearer brighter; empty: dark blue)",
+                           buffer->width(), buffer->height(), buffer->covered_texels());
+    }
     const std::string file = numbered(a.out, k, range);
-    if (!stbi_write_png(file.c_str(), size.width, size.height, 4, pixels.data(), size.width * 4))
+    if (!stbi_write_png(file.c_str(), image_width, size.height, 4, pixels.data(), image_width * 4))
       throw occull::InputError(fmt::format("cannot write '{}'", file));
     fmt::print("wrote {} ({}x{}): {} / {} frame {} with {}, view {}: {} objects, {} triangles drawn, {} queries{}\n",
-               file, size.width, size.height, a.scene, path.name(), k, algo, a.view, stats.objects_rendered,
+               file, image_width, size.height, a.scene, path.name(), k, algo, a.view, stats.objects_rendered,
                stats.triangles, stats.queries, legend);
   }
   session.release(*culler);
@@ -1022,6 +1043,8 @@ int main(int argc, char** argv) {
   r->add_option("--out,--png", render.out, "output PNG file")->capture_default_str();
   std::string view_help = "what to draw:";
   for (const auto& v : occull::debug_views()) view_help += fmt::format(" {}: {};", v.name, v.summary);
+  view_help += " soc: the frame with the CPU occlusion buffer the culler used beside it (soc; chc, chcpp, nohc with "
+               "cpu_test=on)";
   r->add_option("--view", render.view, view_help)->capture_default_str();
   r->add_option("--opt", render.opts, "algorithm option algo.key=value (repeatable)");
   r->add_flag("--gl-debug", render.gl_debug, kGlDebugHelp);

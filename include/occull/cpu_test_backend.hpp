@@ -46,6 +46,8 @@ class CpuTestBackend final : public Backend {
   /// Ends the frame: adds the buffer's counters (raster_ms, test_ms,
   /// occluder_triangles, boxes_tested, buffer_texels) to `stats`.
   void end_frame(FrameStats& stats);
+  /// The buffer of the current (or last) frame; null before the first.
+  [[nodiscard]] const OcclusionBuffer* buffer() const noexcept;
   /// Queries of this frame answered on the CPU.
   [[nodiscard]] std::uint64_t answered() const noexcept;
 

@@ -18,6 +18,8 @@
 
 namespace occull {
 
+class OcclusionBuffer;
+
 struct HardwareProfile;
 
 /// What a culler reads: the scene and its hierarchy, shared read-only by
@@ -111,6 +113,11 @@ class Culler {
   /// queried). Empty for cullers without such regions. Valid until the
   /// next render_frame().
   [[nodiscard]] virtual std::span<const CullRegion> regions() const { return {}; }
+
+  /// Optional, for the debug views: the CPU occlusion buffer the last
+  /// render_frame() culled with (`soc`; `chc`, `chcpp`, `nohc` with
+  /// cpu_test=on), or null. Valid until the next render_frame().
+  [[nodiscard]] virtual const OcclusionBuffer* occlusion_buffer() const { return nullptr; }
 
   /// Hands back every query the culler holds, through `backend` (which must
   /// reach the device they were issued on): the answers it can use are read

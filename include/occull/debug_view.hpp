@@ -11,6 +11,7 @@
 
 #include "occull/culler.hpp"
 #include "occull/frame_log.hpp"
+#include "occull/occlusion_buffer.hpp"
 #include "occull/scene.hpp"
 #include "occull/view.hpp"
 
@@ -73,6 +74,13 @@ enum class QueryOutcome : std::uint8_t {
 /// centre of its box lies in one of the query's boxes (every hierarchy
 /// node, tight box and cell box holds the centres of its objects).
 [[nodiscard]] std::vector<QueryOutcome> classify_queries(const Scene& scene, const FrameLog& log);
+
+/// A CPU occlusion buffer as an RGBA image of width × height pixels, top
+/// row first (as PNGs are written), each texel a block of pixels (nearest
+/// texel): covered texels in grey, nearer brighter (keys scaled between the
+/// nearest and farthest covered texel), empty ones dark blue.
+/// Preconditions: width, height >= 1.
+[[nodiscard]] std::vector<std::uint8_t> occlusion_buffer_rgba(const OcclusionBuffer& buffer, int width, int height);
 
 /// A picture in world space, drawn in this order: the background (the
 /// frame's image, or `clear`), `objects` in flat colours (depth-tested),

@@ -7,6 +7,7 @@
 #include <glm/gtc/matrix_transform.hpp>
 
 #include <algorithm>
+#include <limits>
 #include <array>
 #include <cmath>
 
@@ -237,6 +238,32 @@ Picture overview_picture(const DebugFrame& f, float aspect) {
 }  // namespace
 
 std::span<const DebugViewInfo> debug_views() { return kViews; }
+
+std::vector<std::uint8_t> occlusion_buffer_rgba(const OcclusionBuffer& buffer, int width, int height) {
+  const std::span<const float> keys = buffer.keys();
+  float lo = std::numeric_limits<float>::infinity(), hi = -lo;
+  for (float k : keys)
+    if (k != std::numeric_limits<float>::infinity()) lo = std::min(lo, k), hi = std::max(hi, k);
+  std::vector<std::uint8_t> out(std::size_t(width) * std::size_t(height) * 4);
+  for (int y = 0; y < height; ++y) {
+    // Pixel rows top first; texel rows bottom first.
+    const int ty = std::min(buffer.height() - 1, (height - 1 - y) * buffer.height() / height);
+    for (int x = 0; x < width; ++x) {
+      const int tx = std::min(buffer.width() - 1, x * buffer.width() / width);
+      const float k = buffer.key_at(tx, ty);
+      std::uint8_t* p = out.data() + (std::size_t(y) * std::size_t(width) + std::size_t(x)) * 4;
+      if (k == std::numeric_limits<float>::infinity()) {
+        p[0] = 25, p[1] = 25, p[2] = 90;
+      } else {
+        const float t = hi > lo ? (k - lo) / (hi - lo) : 0.0f;  // 0 nearest, 1 farthest
+        const auto g = std::uint8_t(std::lround(235.0f - 175.0f * t));
+        p[0] = p[1] = p[2] = g;
+      }
+      p[3] = 255;
+    }
+  }
+  return out;
+}
 
 DebugView parse_debug_view(std::string_view name) {
   for (const DebugViewInfo& v : kViews)

@@ -80,6 +80,10 @@ void CpuTestBackend::end_frame(FrameStats& stats) {
   impl_->view = nullptr;
 }
 
+const OcclusionBuffer* CpuTestBackend::buffer() const noexcept {
+  return impl_->buffer ? &*impl_->buffer : nullptr;
+}
+
 std::uint64_t CpuTestBackend::answered() const noexcept { return impl_->answered; }
 
 void CpuTestBackend::render(std::span<const ObjectId> objects) {

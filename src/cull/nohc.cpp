@@ -107,6 +107,9 @@ class NohcCuller final : public Culler {
     return cull_with_cpu_test(cpu_test_.get(), view, backend,
                               [this](const View& v, Backend& b) { return cull_frame(v, b); });
   }
+  [[nodiscard]] const OcclusionBuffer* occlusion_buffer() const override {
+    return cpu_test_ ? cpu_test_->buffer() : nullptr;
+  }
 
  private:
   FrameStats cull_frame(const View& view, Backend& backend) {

@@ -78,6 +78,7 @@ class SocCuller final : public Culler {
     if (!queue_.empty()) backend.render(queue_);
     return stats;
   }
+  [[nodiscard]] const OcclusionBuffer* occlusion_buffer() const override { return buffer_ ? &*buffer_ : nullptr; }
 
  private:
   OcclusionBuffer& buffer_for(const View& view) {
