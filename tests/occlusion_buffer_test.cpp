@@ -289,6 +289,40 @@ TEST(OcclusionBuffer, OccluderMeshMergesCoplanarConvexPairsAndSortsLargestFirst)
   EXPECT_EQ(quads, 2);
 }
 
+// The tiles' farthest depths only shortcut the texels' answer.
+TEST(OcclusionBuffer, TilesAnswerAsTexelsDo) {
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<float> u(-4.0f, 40.0f), dist(1.0f, 40.0f);
+  const View view = make_view(CameraPose{}, Lens{60.0f, 0.1f, 100.0f}, 640, 360);
+  int hidden = 0, tested = 0;
+  for (int round = 0; round < 20; ++round) {
+    OcclusionBuffer tiles(64, 36), texels(64, 36, SimdPath::best, {.tiles = false});
+    tiles.clear(view.clip);
+    texels.clear(view.clip);
+    std::vector<glm::vec3> pos;
+    std::vector<std::uint32_t> idx;
+    for (int k = 0; k < 20; ++k) {  // random walls facing the eye
+      const float x = u(rng) - 20.0f, y = 0.5f * u(rng) - 10.0f, d = dist(rng), w = 0.3f * u(rng) + 1.0f;
+      const auto base = std::uint32_t(pos.size());
+      pos.insert(pos.end(), {{x, y, -d}, {x + w, y, -d}, {x + w, y + w, -d}, {x, y + w, -d}});
+      idx.insert(idx.end(), {base, base + 1, base + 2, base, base + 2, base + 3});
+    }
+    const OccluderMesh mesh = make_occluder_mesh(pos, idx);
+    tiles.rasterize(pos, mesh, mesh.polygons(), glm::dmat4(view.view_proj));
+    texels.rasterize(pos, mesh, mesh.polygons(), glm::dmat4(view.view_proj));
+    for (int k = 0; k < 200; ++k) {
+      const glm::vec3 c(u(rng) - 20.0f, 0.5f * u(rng) - 10.0f, -dist(rng) - 2.0f);
+      const Aabb b{c, c + glm::vec3(0.2f * u(rng) + 0.1f, 0.1f * u(rng) + 0.1f, 1.0f)};
+      const bool a = tiles.occluded(b, view.view_proj);
+      ASSERT_EQ(a, texels.occluded(b, view.view_proj)) << "round " << round << " box " << k;
+      hidden += a;
+      ++tested;
+    }
+  }
+  EXPECT_GT(hidden, tested / 20);  // both answers came up
+  EXPECT_LT(hidden, tested);
+}
+
 // The vectorised loops equal the scalar reference bit for bit, and so do
 // the answers, over random occluders, sizes and boxes.
 TEST(OcclusionBuffer, SimdMatchesScalar) {

@@ -1134,6 +1134,9 @@ int main(int argc, char** argv) {
   ra->add_option("--sizes", raster.sizes, "comma-separated buffer sizes WIDTHxHEIGHT")->capture_default_str();
   ra->add_option("--frames", raster.frames, "frames spread over the path")->capture_default_str();
   ra->add_option("--repeat", raster.repeat, "timings of each frame; the fastest counts")->capture_default_str();
+  ra->add_option("--detail", raster.detail, "as soc.detail: polygons below 1/detail of their mesh's largest "
+                                            "inscribed circle left out (0: all)")
+      ->capture_default_str();
 
 #ifdef OCCULL_OSG
   OsgArgs osg_args;

@@ -53,7 +53,8 @@ int cmd_raster(const RasterArgs& a) {
   for (const Object& o : scene.objects())
     if (!o.removed && o.occluder != OccluderClass::never && !scene.material(o.material).translucent &&
         !scene.mesh(o.mesh).positions.empty() && !occluders.count(o.mesh))
-      occluders.emplace(o.mesh, make_occluder_mesh(scene.mesh(o.mesh).positions, scene.mesh(o.mesh).indices));
+      occluders.emplace(o.mesh,
+                        make_occluder_mesh(scene.mesh(o.mesh).positions, scene.mesh(o.mesh).indices, a.detail));
 
   fmt::print("scene {}, path {}, {} frames spread over the path, best of {} timings each; one core; "
              "SIMD: {}\n",

@@ -11,6 +11,7 @@ struct RasterArgs {
   std::string sizes = "320x180,1280x720";
   int frames = 50;
   int repeat = 5;
+  double detail = 8.0;  // as soc.detail
 };
 
 /// Rasterizes the occluders a camera path sees into buffers of each size,

@@ -28,6 +28,7 @@ class CpuTestBackend final : public Backend {
     int scale = 4;            ///< buffer = viewport / scale on each axis (>= 1)
     int budget = 20000;       ///< triangles of `sometimes` occluders rasterized per frame
     double min_texels = 2.0;  ///< occluders spanning fewer texels across are not rasterized
+    double detail = 8.0;      ///< polygons below 1/detail of their mesh's largest inscribed circle left out (0: none)
     SimdPath simd = SimdPath::best;
   };
 

@@ -99,6 +99,7 @@ struct OcclusionRules {
   bool nearest_corner = true;       ///< rule 6; false: the box's centre depth
   bool reaching_eye_visible = true; ///< rule 7; false: corners behind the eye or near plane dropped
   bool depth_margin = true;         ///< rule 8; false: hidden when the box's depth is not nearer (ties hidden)
+  bool tiles = true;                ///< false: no tile shortcut, every texel read (the answers must not change)
 };
 
 /// Which code runs the inner loops.
@@ -137,10 +138,13 @@ struct OccluderMesh {
 };
 /// Builds an OccluderMesh from a triangle mesh (3 indices per triangle;
 /// degenerate triangles left out). Edges are matched by vertex position, so
-/// meshes that do not share vertices merge too. Precondition: indices <
-/// positions.size().
+/// meshes that do not share vertices merge too. `detail` > 0 leaves out the
+/// polygons whose inscribed circle is smaller than 1/detail of the largest
+/// (a building's window sills beside its walls: they cost the rasterizer
+/// and rarely cover a texel the walls do not); 0 keeps them all. Leaving a
+/// polygon out hides nothing. Precondition: indices < positions.size().
 [[nodiscard]] OccluderMesh make_occluder_mesh(std::span<const glm::vec3> positions,
-                                              std::span<const std::uint32_t> indices);
+                                              std::span<const std::uint32_t> indices, double detail = 0.0);
 
 /// A width × height occlusion buffer over a viewport, and its box test.
 /// Not thread-safe; one per culler (and per view size).

@@ -68,7 +68,8 @@ std::size_t OccluderMesh::count_at_least(float radius) const noexcept {
                      inradius.begin());
 }
 
-OccluderMesh make_occluder_mesh(std::span<const glm::vec3> positions, std::span<const std::uint32_t> indices) {
+OccluderMesh make_occluder_mesh(std::span<const glm::vec3> positions, std::span<const std::uint32_t> indices,
+                                double detail) {
   struct Tri {
     std::uint32_t v[3];
     glm::dvec3 normal;  // unnormalised: twice the area
@@ -158,6 +159,11 @@ OccluderMesh make_occluder_mesh(std::span<const glm::vec3> positions, std::span<
     if (!done) add(tris[t].v, 3);
   }
   std::stable_sort(polys.begin(), polys.end(), [](const Poly& x, const Poly& y) { return x.radius > y.radius; });
+  if (detail > 0.0 && !polys.empty()) {
+    const float smallest = float(double(polys.front().radius) / detail);
+    polys.erase(std::partition_point(polys.begin(), polys.end(), [&](const Poly& p) { return p.radius >= smallest; }),
+                polys.end());
+  }
   OccluderMesh out;
   out.corners.reserve(polys.size() * 4);
   out.inradius.reserve(polys.size());
@@ -227,31 +233,37 @@ std::uint32_t OcclusionBuffer::rasterize(std::span<const glm::vec3> positions, c
   if (count == 0) return 0;
   const glm::dmat4 object_to_clip = glm::dmat4(view.view_proj) * glm::dmat4(object_to_world);
   if (view.orthographic) return rasterize(positions, mesh, count, object_to_clip);
-  // Per polygon, in object space: its side of the eye, its size on the
-  // buffer at its distance (as polygons_worth_rasterizing, per polygon), and
-  // its area seen at its angle, which must hold a circle of half a texel
-  // (pi / 4 texels): a wall seen edge on along a street covers nothing.
+  // Per polygon, in object space: its side of the eye; its size on the
+  // buffer at the nearest view depth of its bounding sphere (a length at view
+  // depth z spans at most f / z * sqrt(1 + tan^2) texels, f texels per unit
+  // at unit depth, tan of the lens's half angles); and its area seen at its
+  // angle, which must hold a circle of half a texel (pi / 4 texels): a wall
+  // seen edge on along a street covers nothing.
   const glm::dmat3 m(object_to_world);
   const double flip = glm::determinant(m) < 0.0 ? -1.0 : 1.0;  // a mirroring transform turns the winding
   const glm::dvec3 eye = glm::dvec3(glm::inverse(glm::dmat4(object_to_world)) * glm::dvec4(glm::dvec3(view.eye), 1.0));
-  const double s0 = glm::length(m[0]), s1 = glm::length(m[1]), s2 = glm::length(m[2]);
-  const double stretch_max = std::max({s0, s1, s2}), stretch_min = std::min({s0, s1, s2});
+  const double stretch = std::max({glm::length(m[0]), glm::length(m[1]), glm::length(m[2])});
   const double fx = std::abs(double(view.proj[0][0])) * 0.5 * double(width_);
   const double fy = std::abs(double(view.proj[1][1])) * 0.5 * double(height_);
   const double tan2 = 1.0 / double(view.proj[0][0] * view.proj[0][0]) + 1.0 / double(view.proj[1][1] * view.proj[1][1]);
-  // Texels per object unit at object-space distance d, at most: this / d.
-  const double reach = std::max(fx, fy) * (1.0 + tan2) * stretch_max / std::max(stretch_min, 1e-30);
-  const double near_object = double(view.near) / std::max(stretch_max, 1e-30);
+  const double per_unit = std::max(fx, fy) * std::sqrt(1.0 + tan2) * stretch;  // texels per object unit at depth 1
+  // View depth of an object-space point: -(row 2 of view * object_to_world) . (p, 1).
+  const glm::dmat4 to_eye = glm::dmat4(view.view) * glm::dmat4(object_to_world);
+  const glm::dvec3 depth_axis(-to_eye[0][2], -to_eye[1][2], -to_eye[2][2]);
+  const double depth_offset = -to_eye[3][2];
+  const double depth_stretch = glm::length(depth_axis);
+  const double near = double(view.near);
   std::uint32_t drawn = 0;
   for (std::size_t p = 0; p < count; ++p) {
     const OccluderMesh::Bounds& b = mesh.bounds[p];
     const double side = flip * (glm::dot(glm::dvec3(b.normal), eye) - double(b.offset));
     if (rules_.front_faces_only && side <= 0.0) continue;
-    const double to_centre = glm::length(eye - glm::dvec3(b.centre));
-    const double d = std::max(to_centre - double(b.radius), near_object);
-    if (double(mesh.inradius[p]) * reach < 0.5 * d) continue;
-    const double cosine = std::min(1.0, std::abs(side) / std::max(to_centre, 1e-30));
-    if (double(b.area) * cosine * (reach / d) * (reach / d) < 0.785) continue;
+    const glm::dvec3 centre(b.centre);
+    const double z = std::max(glm::dot(depth_axis, centre) + depth_offset - depth_stretch * double(b.radius), near);
+    const double texels = per_unit / z;  // per object unit, at most
+    if (double(mesh.inradius[p]) * texels < 0.5) continue;
+    const double cosine = std::min(1.0, std::abs(side) / std::max(glm::length(eye - centre), 1e-30));
+    if (double(b.area) * cosine * texels * texels < 0.785) continue;
     const std::uint32_t* corners = mesh.corners.data() + 4 * p;
     const int n = corners[3] == OccluderMesh::no_corner ? 3 : 4;
     glm::dvec4 c[4];
@@ -563,7 +575,7 @@ bool OcclusionBuffer::occluded(const Aabb& box, const glm::mat4& view_proj) {
   const bool margin = rules_.depth_margin;
   for (int ty = y0 / tile_size; ty <= y1 / tile_size; ++ty)
     for (int tx = x0 / tile_size; tx <= x1 / tile_size; ++tx) {
-      if (behind(nearest, tile_farthest(tx, ty), margin)) continue;  // the whole tile hides the box
+      if (rules_.tiles && behind(nearest, tile_farthest(tx, ty), margin)) continue;  // the whole tile hides the box
       const int ax = std::max(x0, tx * tile_size), bx = std::min(x1, tx * tile_size + tile_size - 1);
       const int ay = std::max(y0, ty * tile_size), by = std::min(y1, ty * tile_size + tile_size - 1);
       for (int y = ay; y <= by; ++y) {

@@ -11,7 +11,7 @@
 namespace occull {
 
 struct CpuTestBackend::Impl {
-  Impl(const Scene& s, const Options& o) : scene(s), options(o), occluders(s, {o.budget, o.min_texels}) {}
+  Impl(const Scene& s, const Options& o) : scene(s), options(o), occluders(s, {o.budget, o.min_texels, o.detail}) {}
 
   struct Slot {
     bool in_use = false;

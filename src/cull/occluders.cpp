@@ -38,7 +38,7 @@ const OccluderMesh& Occluders::occluder_of(MeshId mesh) {
   if (meshes_.size() <= mesh) meshes_.resize(std::size_t(mesh) + 1);
   if (!meshes_[mesh]) {
     const Mesh& m = scene_.mesh(mesh);
-    meshes_[mesh] = make_occluder_mesh(m.positions, m.indices);
+    meshes_[mesh] = make_occluder_mesh(m.positions, m.indices, choice_.detail);
   }
   return *meshes_[mesh];
 }

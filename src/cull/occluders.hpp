@@ -15,6 +15,7 @@ namespace occull::detail {
 struct OccluderChoice {
   int budget = 20000;       ///< triangles of `sometimes` occluders per frame (`always` ones always)
   double min_texels = 2.0;  ///< occluders whose bounding sphere spans fewer texels across are not rasterized
+  double detail = 8.0;      ///< polygons below 1/detail of their mesh's largest inscribed circle left out (0: none)
 };
 
 /// Occluders: opaque objects of class `always`, and of class `sometimes`

@@ -117,6 +117,9 @@ Registration soc_registration() {
                    "triangles of `sometimes` occluders rasterized per frame (`always` ones always are)")
           .real("min_texels", [](auto& c) -> auto& { return c.occluders.min_texels; }, 0.0, 1e6,
                 "occluders whose bounding sphere spans fewer texels across are not rasterized")
+          .real("detail", [](auto& c) -> auto& { return c.occluders.detail; }, 0.0, 1e6,
+                "an occluder's polygons whose inscribed circle is below 1/detail of its largest are not rasterized "
+                "(0: all)")
           .flag("simd", &SocConfig::simd, "vectorised inner loops (off: the scalar reference, equal bit for bit)");
   return registered({"soc",
                      "software occlusion culling: a strictly conservative CPU occlusion buffer, occluders "
