@@ -69,8 +69,10 @@ class SocCuller final : public Culler {
       }
       leaf_.clear();
       append_objects_in_frustum(index_, n, view, leaf_, frustum_.planes(n));
+      // A leaf of one object: its box is the node's, tested above (the root aside).
+      const bool tested = leaf_.size() == 1 && bvh.node(n).object_count == 1 && n != Bvh::root();
       for (ObjectId id : leaf_) {
-        if (hidden(buffer, index_.scene.object(id).bounds, view, stats)) continue;
+        if (!tested && hidden(buffer, index_.scene.object(id).bounds, view, stats)) continue;
         queue_.push_back(id);
         occluders_.rasterize_if_occluder(buffer, id, view, stats);
       }
