@@ -73,6 +73,20 @@ struct PyramidRules {
 /// depth_tolerance(far).
 [[nodiscard]] float depth_tolerance(float far_key) noexcept;
 
+/// A box's 8 corners projected onto a width × height image (the depth
+/// pyramid's level 0, an occlusion buffer): what both box tests start from.
+struct BoxFootprint {
+  bool reaches_eye = false;  ///< a corner behind the eye or in front of the near plane
+  int projected = 0;         ///< corners beyond the near plane, which the rest describes
+  float min_x = 0, min_y = 0, max_x = 0, max_y = 0;  ///< their rectangle, in image units
+  float min_depth = 0, max_depth = 0;                ///< their window depths
+};
+/// Projects `box` through `view_proj` with clip conventions `clip`.
+[[nodiscard]] BoxFootprint project_box(const Aabb& box, const glm::mat4& view_proj, const ClipSpace& clip, int width,
+                                       int height) noexcept;
+/// The window depth of world point `p` (no check of w).
+[[nodiscard]] float window_depth(const glm::vec3& p, const glm::mat4& view_proj, const ClipSpace& clip) noexcept;
+
 /// The coarsest level at which a rectangle of `extent` texels at level 0
 /// (the larger of its width and height, >= 1) spans at most 2×2 texels:
 /// ceil(log2(extent)).

@@ -206,6 +206,8 @@ class OcclusionBuffer {
   [[nodiscard]] std::size_t covered_texels() const noexcept;
 
  private:
+  void raster_mesh_polygon(std::span<const glm::vec3> positions, const OccluderMesh& mesh, std::size_t p,
+                           const glm::dmat4& object_to_clip, std::uint32_t& count);
   void raster_clipped(const glm::dvec4* clip, int n, std::uint32_t& count);
   void raster_polygon(const glm::dvec3* v, int n, std::uint32_t& count);
   float tile_farthest(int tx, int ty);

@@ -14,6 +14,38 @@ namespace occull {
 
 float depth_tolerance(float far_key) noexcept { return 4e-6f * std::abs(far_key) + 4e-7f; }
 
+BoxFootprint project_box(const Aabb& box, const glm::mat4& view_proj, const ClipSpace& clip, int width,
+                         int height) noexcept {
+  constexpr float inf = std::numeric_limits<float>::infinity();
+  BoxFootprint f{false, 0, inf, inf, -inf, -inf, inf, -inf};
+  for (int i = 0; i < 8; ++i) {
+    const glm::vec4 c = view_proj * glm::vec4(box.corner(i), 1.0f);
+    const float ndc_z = c.z / c.w;
+    const bool before_near = clip.reversed_z ? ndc_z > 1.0f : ndc_z < clip.near_depth();
+    if (c.w <= 0.0f || before_near) {
+      f.reaches_eye = true;
+      continue;
+    }
+    ++f.projected;
+    const float depth = clip.depth == DepthRange::zero_to_one ? ndc_z : ndc_z * 0.5f + 0.5f;
+    f.min_depth = std::min(f.min_depth, depth);
+    f.max_depth = std::max(f.max_depth, depth);
+    const float px = (c.x / c.w * 0.5f + 0.5f) * float(width);
+    const float py = (c.y / c.w * 0.5f + 0.5f) * float(height);
+    f.min_x = std::min(f.min_x, px);
+    f.max_x = std::max(f.max_x, px);
+    f.min_y = std::min(f.min_y, py);
+    f.max_y = std::max(f.max_y, py);
+  }
+  return f;
+}
+
+float window_depth(const glm::vec3& p, const glm::mat4& view_proj, const ClipSpace& clip) noexcept {
+  const glm::vec4 c = view_proj * glm::vec4(p, 1.0f);
+  const float ndc_z = c.z / c.w;
+  return clip.depth == DepthRange::zero_to_one ? ndc_z : ndc_z * 0.5f + 0.5f;
+}
+
 int pyramid_level_for(int extent) noexcept {
   if (extent <= 1) return 0;
   return std::bit_width(unsigned(extent - 1));  // ceil(log2(extent))
@@ -54,36 +86,13 @@ bool DepthPyramid::occluded(const Aabb& box, const glm::mat4& view_proj, const C
   assert(texels == 2 || texels == 4 || texels == 8 || texels == 16);
   if (box.empty()) return true;  // nothing to draw
   const Level& base = levels_.front();
-  constexpr float inf = std::numeric_limits<float>::infinity();
-  float min_x = inf, min_y = inf, max_x = -inf, max_y = -inf;
-  float nearest = inf;  // key
-  int projected = 0;
-  for (int i = 0; i < 8; ++i) {
-    const glm::vec3 corner((i & 1) ? box.max.x : box.min.x, (i & 2) ? box.max.y : box.min.y,
-                           (i & 4) ? box.max.z : box.min.z);
-    const glm::vec4 c = view_proj * glm::vec4(corner, 1.0f);
-    const float ndc_z = c.z / c.w;
-    const bool before_near = clip.reversed_z ? ndc_z > 1.0f : ndc_z < clip.near_depth();
-    if (c.w <= 0.0f || before_near) {
-      if (rules_.reaching_eye_visible) return false;  // rule 6
-      continue;
-    }
-    ++projected;
-    const float depth = clip.depth == DepthRange::zero_to_one ? ndc_z : ndc_z * 0.5f + 0.5f;
-    nearest = std::min(nearest, key(depth));
-    const float px = (c.x / c.w * 0.5f + 0.5f) * float(base.width);
-    const float py = (c.y / c.w * 0.5f + 0.5f) * float(base.height);
-    min_x = std::min(min_x, px);
-    max_x = std::max(max_x, px);
-    min_y = std::min(min_y, py);
-    max_y = std::max(max_y, py);
-  }
-  if (projected == 0) return false;
-  if (!rules_.nearest_corner) {  // rule 5 broken: the centre's depth
-    const glm::vec4 c = view_proj * glm::vec4(box.center(), 1.0f);
-    const float ndc_z = c.z / c.w;
-    nearest = key(clip.depth == DepthRange::zero_to_one ? ndc_z : ndc_z * 0.5f + 0.5f);
-  }
+  const BoxFootprint f = project_box(box, view_proj, clip, base.width, base.height);
+  if (f.reaches_eye && rules_.reaching_eye_visible) return false;  // rule 6
+  if (f.projected == 0) return false;
+  // Rule 5: the nearest corner (as a key, larger farther).
+  float nearest = std::min(key(f.min_depth), key(f.max_depth));
+  if (!rules_.nearest_corner) nearest = key(window_depth(box.center(), view_proj, clip));  // broken: the centre's
+  const float min_x = f.min_x, max_x = f.max_x, min_y = f.min_y, max_y = f.max_y;
   // Rule 3: every pixel the rectangle touches, widened for rounding.
   constexpr float margin = 1.0f / 64.0f;
   // (Clamped as floats first: a corner just in front of the eye projects
@@ -106,7 +115,7 @@ bool DepthPyramid::occluded(const Aabb& box, const glm::mat4& view_proj, const C
   const int tx = std::min(x0 >> level, l.width - 1), ty = std::min(y0 >> level, l.height - 1);
   const int tx1 = std::min({x1 >> level, tx + texels - 1, l.width - 1});
   const int ty1 = std::min({y1 >> level, ty + texels - 1, l.height - 1});
-  float farthest = -inf;
+  float farthest = -std::numeric_limits<float>::infinity();
   for (int y = ty; y <= ty1; ++y)
     for (int x = tx; x <= tx1; ++x)
       farthest = std::max(farthest, key(l.texels[std::size_t(y) * std::size_t(l.width) + std::size_t(x)]));

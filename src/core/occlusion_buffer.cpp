@@ -218,11 +218,7 @@ std::uint32_t OcclusionBuffer::rasterize(std::span<const glm::vec3> positions, c
   assert(count <= mesh.polygons());
   std::uint32_t drawn = 0;
   for (std::size_t p = 0; p < count; ++p) {
-    const std::uint32_t* corners = mesh.corners.data() + 4 * p;
-    const int n = corners[3] == OccluderMesh::no_corner ? 3 : 4;
-    glm::dvec4 c[4];
-    for (int k = 0; k < n; ++k) c[k] = object_to_clip * glm::dvec4(glm::dvec3(positions[corners[k]]), 1.0);
-    raster_clipped(c, n, drawn);
+    raster_mesh_polygon(positions, mesh, p, object_to_clip, drawn);
   }
   return drawn;
 }
@@ -264,13 +260,18 @@ std::uint32_t OcclusionBuffer::rasterize(std::span<const glm::vec3> positions, c
     if (double(mesh.inradius[p]) * texels < 0.5) continue;
     const double cosine = std::min(1.0, std::abs(side) / std::max(glm::length(eye - centre), 1e-30));
     if (double(b.area) * cosine * texels * texels < 0.785) continue;
-    const std::uint32_t* corners = mesh.corners.data() + 4 * p;
-    const int n = corners[3] == OccluderMesh::no_corner ? 3 : 4;
-    glm::dvec4 c[4];
-    for (int k = 0; k < n; ++k) c[k] = object_to_clip * glm::dvec4(glm::dvec3(positions[corners[k]]), 1.0);
-    raster_clipped(c, n, drawn);
+    raster_mesh_polygon(positions, mesh, p, object_to_clip, drawn);
   }
   return drawn;
+}
+
+void OcclusionBuffer::raster_mesh_polygon(std::span<const glm::vec3> positions, const OccluderMesh& mesh,
+                                          std::size_t p, const glm::dmat4& object_to_clip, std::uint32_t& count) {
+  const std::uint32_t* corners = mesh.corners.data() + 4 * p;
+  const int n = corners[3] == OccluderMesh::no_corner ? 3 : 4;
+  glm::dvec4 c[4];
+  for (int k = 0; k < n; ++k) c[k] = object_to_clip * glm::dvec4(glm::dvec3(positions[corners[k]]), 1.0);
+  raster_clipped(c, n, count);
 }
 
 // Rule 1: clips a convex polygon at the near plane and the guard band (in
@@ -528,34 +529,16 @@ float OcclusionBuffer::tile_farthest(int tx, int ty) {
 
 bool OcclusionBuffer::occluded(const Aabb& box, const glm::mat4& view_proj) {
   if (box.empty()) return false;
-  float min_x = kInf, min_y = kInf, max_x = -kInf, max_y = -kInf;
-  float nearest = kInf;
-  int projected = 0;
-  for (int i = 0; i < 8; ++i) {
-    const glm::vec4 c = view_proj * glm::vec4(box.corner(i), 1.0f);
-    const float ndc_z = c.z / c.w;
-    const bool before_near = clip_.reversed_z ? ndc_z > 1.0f : ndc_z < clip_.near_depth();
-    if (c.w <= 0.0f || before_near) {
-      if (rules_.reaching_eye_visible) return false;  // rule 7
-      continue;
-    }
-    ++projected;
-    const float depth = clip_.depth == DepthRange::zero_to_one ? ndc_z : ndc_z * 0.5f + 0.5f;
-    nearest = std::min(nearest, clip_.reversed_z ? -depth : depth);
-    const float px = (c.x / c.w * 0.5f + 0.5f) * float(width_);
-    const float py = (c.y / c.w * 0.5f + 0.5f) * float(height_);
-    min_x = std::min(min_x, px);
-    max_x = std::max(max_x, px);
-    min_y = std::min(min_y, py);
-    max_y = std::max(max_y, py);
-  }
-  if (projected == 0) return false;
-  if (!rules_.nearest_corner) {  // rule 6 broken: the centre's depth
-    const glm::vec4 c = view_proj * glm::vec4(box.center(), 1.0f);
-    const float ndc_z = c.z / c.w;
-    const float depth = clip_.depth == DepthRange::zero_to_one ? ndc_z : ndc_z * 0.5f + 0.5f;
+  const BoxFootprint f = project_box(box, view_proj, clip_, width_, height_);
+  if (f.reaches_eye && rules_.reaching_eye_visible) return false;  // rule 7
+  if (f.projected == 0) return false;
+  // Rule 6: the nearest corner, as a key.
+  float nearest = clip_.reversed_z ? -f.max_depth : f.min_depth;
+  if (!rules_.nearest_corner) {  // broken: the centre's depth
+    const float depth = window_depth(box.center(), view_proj, clip_);
     nearest = clip_.reversed_z ? -depth : depth;
   }
+  const float min_x = f.min_x, max_x = f.max_x, min_y = f.min_y, max_y = f.max_y;
   // Rule 5: every texel the rectangle touches, grown for rounding. (Clamped
   // as floats first: a corner just past the near plane projects far off.)
   const auto texel = [](float v, int size) { return int(std::clamp(std::floor(v), -1.0f, float(size))); };

@@ -30,21 +30,13 @@ struct ChcConfig {
   std::uint32_t flush_every = 8;  ///< queries handed to the device together
 };
 
-class ChcCuller final : public Culler {
+class ChcCuller final : public CpuTestedCuller {
  public:
   ChcCuller(const SceneIndex& index, const ChcConfig& c)
-      : index_(index), common_(c.common), cpu_test_(make_cpu_test(index, c.common)), skip_(c.skip), state_(index.bvh.size()), submitter_(c.flush_every) {}
-
-  FrameStats cull(const View& view, Backend& backend) override {
-    return cull_with_cpu_test(cpu_test_.get(), view, backend,
-                              [this](const View& v, Backend& b) { return cull_frame(v, b); });
-  }
-  [[nodiscard]] const OcclusionBuffer* occlusion_buffer() const override {
-    return cpu_test_ ? cpu_test_->buffer() : nullptr;
-  }
+      : CpuTestedCuller(index, c.common), index_(index), common_(c.common), skip_(c.skip), state_(index.bvh.size()), submitter_(c.flush_every) {}
 
  private:
-  FrameStats cull_frame(const View& view, Backend& backend) {
+  FrameStats cull_frame(const View& view, Backend& backend) override {
     ++frame_;
     seen_.begin(index_.scene);
     if (seen_.rebuilt(index_.bvh)) carry_over(state_, index_.bvh, seen_, frame_ - 1);
@@ -130,7 +122,6 @@ class ChcCuller final : public Culler {
 
   SceneIndex index_;
   CommonOptions common_;
-  std::unique_ptr<CpuTestBackend> cpu_test_;
   std::uint32_t skip_;
   std::vector<NodeState> state_;
   ObjectVisibility seen_;  // what was drawn, for state_ after a rebuild of the hierarchy

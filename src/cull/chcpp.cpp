@@ -108,22 +108,14 @@ std::uint64_t next_random(std::uint64_t& state) {
   return z ^ (z >> 31);
 }
 
-class ChcppCuller final : public Culler {
+class ChcppCuller final : public CpuTestedCuller {
  public:
   ChcppCuller(const SceneIndex& index, const ChcppConfig& config)
-      : index_(index), config_(config), persistence_(config.pkeep_min_samples),
+      : CpuTestedCuller(index, config.common), index_(index), config_(config), persistence_(config.pkeep_min_samples),
         state_(index.bvh.size()), random_(config.seed), gate_(reset_nodes(), config.enter_p_min) {}
 
-  FrameStats cull(const View& view, Backend& backend) override {
-    return cull_with_cpu_test(cpu_test_.get(), view, backend,
-                              [this](const View& v, Backend& b) { return cull_frame(v, b); });
-  }
-  [[nodiscard]] const OcclusionBuffer* occlusion_buffer() const override {
-    return cpu_test_ ? cpu_test_->buffer() : nullptr;
-  }
-
  private:
-  FrameStats cull_frame(const View& view, Backend& backend) {
+  FrameStats cull_frame(const View& view, Backend& backend) override {
     ++frame_;
     seen_.begin(index_.scene);
     if (seen_.rebuilt(index_.bvh)) {
@@ -391,7 +383,6 @@ class ChcppCuller final : public Culler {
 
   SceneIndex index_;
   ChcppConfig config_;
-  std::unique_ptr<CpuTestBackend> cpu_test_ = make_cpu_test(index_, config_.common);
   VisibilityPersistence persistence_;
   std::vector<NodeState> state_;
   ObjectVisibility seen_;  // what was drawn, for state_ after a rebuild of the hierarchy

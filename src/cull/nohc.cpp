@@ -93,26 +93,18 @@ struct NohcConfig {
   bool learn = true;              // correct p_occl by the measured outcomes (OcclusionCalibration)
 };
 
-class NohcCuller final : public Culler {
+class NohcCuller final : public CpuTestedCuller {
  public:
   NohcCuller(const SceneIndex& index, const NohcConfig& config, HardwareProfile profile)
-      : index_(index), config_(config), hw_(std::move(profile)), nodes_(index.bvh.size()),
+      : CpuTestedCuller(index, config.common), index_(index), config_(config), hw_(std::move(profile)), nodes_(index.bvh.size()),
         submitter_(config.flush_every) {
     (void)seen_.rebuilt(index.bvh);
     describe_nodes();
     max_parallel_ = config.max_parallel > 0 ? config.max_parallel : std::max(1, hw_.max_parallel_queries());
   }
 
-  FrameStats cull(const View& view, Backend& backend) override {
-    return cull_with_cpu_test(cpu_test_.get(), view, backend,
-                              [this](const View& v, Backend& b) { return cull_frame(v, b); });
-  }
-  [[nodiscard]] const OcclusionBuffer* occlusion_buffer() const override {
-    return cpu_test_ ? cpu_test_->buffer() : nullptr;
-  }
-
  private:
-  FrameStats cull_frame(const View& view, Backend& backend) {
+  FrameStats cull_frame(const View& view, Backend& backend) override {
     ++frame_;
     // A rebuilt hierarchy starts from what was drawn last frame (carry_over;
     // conservative whatever it says: only queries cull); a changed set of
@@ -358,7 +350,6 @@ class NohcCuller final : public Culler {
 
   SceneIndex index_;
   NohcConfig config_;
-  std::unique_ptr<CpuTestBackend> cpu_test_ = make_cpu_test(index_, config_.common);
   HardwareProfile hw_;
   std::vector<NodeInfo> nodes_;
   double levels_ = 1.0;

@@ -259,20 +259,32 @@ struct CommonOptions {
   bool cpu_test = false;                 ///< ask a CPU occlusion buffer before each query (CpuTestBackend)
 };
 
-/// The CPU first test a culler with these options runs its frames through, or null.
-inline std::unique_ptr<CpuTestBackend> make_cpu_test(const SceneIndex& index, const CommonOptions& options) {
-  return options.cpu_test ? std::make_unique<CpuTestBackend>(index.scene) : nullptr;
-}
+/// A query culler whose frames run through the CPU first test when its
+/// options ask for it (CommonOptions::cpu_test; occull/cpu_test_backend.hpp):
+/// the culler's cull_frame() sees a CpuTestBackend over the frame's backend.
+class CpuTestedCuller : public Culler {
+ public:
+  CpuTestedCuller(const SceneIndex& index, const CommonOptions& options)
+      : cpu_test_(options.cpu_test ? std::make_unique<CpuTestBackend>(index.scene) : nullptr) {}
 
-/// Runs `cull(view, backend)`, through `test` (the CPU first test) when it is set.
-template <class F>
-FrameStats cull_with_cpu_test(CpuTestBackend* test, const View& view, Backend& backend, F&& cull) {
-  if (!test) return cull(view, backend);
-  test->begin_frame(backend, view);
-  FrameStats stats = cull(view, static_cast<Backend&>(*test));
-  test->end_frame(stats);
-  return stats;
-}
+  FrameStats cull(const View& view, Backend& backend) final {
+    if (!cpu_test_) return cull_frame(view, backend);
+    cpu_test_->begin_frame(backend, view);
+    FrameStats stats = cull_frame(view, *cpu_test_);
+    cpu_test_->end_frame(stats);
+    return stats;
+  }
+  [[nodiscard]] const OcclusionBuffer* occlusion_buffer() const final {
+    return cpu_test_ ? cpu_test_->buffer() : nullptr;
+  }
+
+ protected:
+  /// The culler's frame, through the first test when it is on.
+  virtual FrameStats cull_frame(const View& view, Backend& backend) = 0;
+
+ private:
+  std::unique_ptr<CpuTestBackend> cpu_test_;
+};
 
 /// Adds the fields of the CommonOptions at `at` (see ConfigTable) to `table`.
 template <class Config, class At>
