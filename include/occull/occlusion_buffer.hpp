@@ -1,8 +1,8 @@
 // occull — a strictly conservative CPU occlusion buffer: a low-resolution
 // depth buffer into which occluder triangles are rasterized and against which
 // boxes are tested, on the CPU, with no GL and no round trip (the `soc`
-// culler; the first test `chcpp:cpu_test=on` and `nohc:cpu_test=on` make
-// before a query).
+// culler; the first test before a query of `chc`, `chcpp` and `nohc` with
+// cpu_test=on, occull/cpu_test_backend.hpp).
 //
 // A box is found hidden only when every pixel of the viewport it could cover
 // is covered by an occluder triangle that is drawn in the same frame and lies
@@ -24,14 +24,16 @@
 //     occull's meshes wind them): a renderer culling back faces does not
 //     draw the others. Degenerate triangles are skipped.
 //                                        (ABackFacingOccluderHidesNothing)
-//  3. Coverage is inner-conservative. Vertices are snapped to 1/256 texel
-//     and edge functions are evaluated exactly in 64-bit integers. A texel
-//     is covered only if the whole texel, grown by 1/64 texel on every side,
-//     lies strictly inside all three edges (the edge function at the
-//     texel's corner farthest outside each edge is > 0: ties are not
-//     covered). The growth covers both rasterizers' vertex snapping (ours
-//     1/512 texel, the GPU's 1/512 pixel, a pixel being no larger than a
-//     texel) and float projection. Covering a texel when its centre is
+//  3. Coverage is inner-conservative, per convex polygon (a triangle, or a
+//     quad merged from two coplanar ones: OccluderMesh). Vertices are
+//     snapped to 1/256 texel and edge functions are evaluated exactly in
+//     64-bit integers. A texel is covered only if the whole texel, grown by
+//     1/64 texel on every side, lies strictly inside every edge (the edge
+//     function at the texel's corner farthest outside each edge is > 0:
+//     ties are not covered). The growth covers both rasterizers' vertex
+//     snapping (ours 1/512 texel, the GPU's 1/512 pixel, a pixel being no
+//     larger than a texel) and float projection; no test shows it failing
+//     (the GPU's snapping is not modelled on the CPU). Covering a texel when its centre is
 //     inside (the GPU's point-sampling rule, MOC's) hides objects seen
 //     through gaps narrower than a texel. A texel covered by two triangles
 //     together but by neither alone is not covered: occlusion lost at seams,
@@ -41,8 +43,9 @@
 //     triangle's depth plane (window depth is affine in window coordinates)
 //     at the grown texel's farthest corner, no farther than the polygon's
 //     farthest vertex, plus a bias of 2^-20 of its depths for float
-//     evaluation and of how far its corners lie off that plane. A texel keeps the nearest of its occluders' values
-//     (every one of them bounds what can be seen there). Depth at the
+//     evaluation and of how far its corners lie off that plane. A texel
+//     keeps the nearest of its occluders' values (every one of them bounds
+//     what can be seen there). Depth at the
 //     texel's centre lets a box poke through a slanted occluder.
 //                                        (ASlantedOccluderHidesOnlyWhatIsBehindItsFarthestPoint)
 //  5. A box is tested over every texel its screen rectangle touches: its 8
