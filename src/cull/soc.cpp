@@ -10,12 +10,12 @@
 // opaque objects of class `always`, and of class `sometimes` while the
 // frame's budget of their triangles lasts, whose mesh has vertices on the
 // CPU (a mesh an engine registered by MeshInfo only never occludes) and that
-// span at least a couple of texels. Of an occluder, only the triangles that
-// could cover a texel whole from this distance are rasterized (their
-// inscribed circle, magnified as much as the lens can, reaches half a
-// texel; OccluderMesh): skipping a triangle never hides anything. Everything rasterized is drawn in the
-// same frame (it passed its own test first), so a box the buffer hides is
-// hidden on screen: the culler is conservative exactly when the buffer is.
+// span at least a couple of texels (occluders.hpp). Of an occluder, only the
+// polygons that could cover a texel whole from where the camera is are
+// rasterized (OcclusionBuffer::rasterize): skipping one never hides
+// anything. Everything rasterized is drawn in the same frame (it passed its
+// own test first), so a box the buffer hides is hidden on screen: the
+// culler is conservative exactly when the buffer is.
 // The queue is drawn in one render-queue flush at the end.
 #include "cullers.hpp"
 #include "traversal.hpp"
