@@ -53,6 +53,20 @@ std::int64_t snap(double v) {
   return std::int64_t((v * double(kSub) + kMagic) - kMagic);
 }
 
+// What choosing polygons needs of a lens on a width × height buffer: texels
+// per unit at unit view depth (the larger axis), and tan^2 of its half
+// angles summed (perspective).
+struct LensReach {
+  double texels_per_unit;
+  double tan2;
+};
+LensReach lens_of(const View& view, int width, int height) {
+  const double fx = std::abs(double(view.proj[0][0])) * 0.5 * double(width);
+  const double fy = std::abs(double(view.proj[1][1])) * 0.5 * double(height);
+  return {std::max(fx, fy),
+          1.0 / double(view.proj[0][0] * view.proj[0][0]) + 1.0 / double(view.proj[1][1] * view.proj[1][1])};
+}
+
 // Rule 8: `nearest` (a box's key) lies behind `farthest` (a texel's or
 // tile's key) by more than depth rounding. +infinity hides nothing.
 bool behind(float nearest, float farthest, bool margin) {
@@ -239,10 +253,8 @@ std::uint32_t OcclusionBuffer::rasterize(std::span<const glm::vec3> positions, c
   const double flip = glm::determinant(m) < 0.0 ? -1.0 : 1.0;  // a mirroring transform turns the winding
   const glm::dvec3 eye = glm::dvec3(glm::inverse(glm::dmat4(object_to_world)) * glm::dvec4(glm::dvec3(view.eye), 1.0));
   const double stretch = std::max({glm::length(m[0]), glm::length(m[1]), glm::length(m[2])});
-  const double fx = std::abs(double(view.proj[0][0])) * 0.5 * double(width_);
-  const double fy = std::abs(double(view.proj[1][1])) * 0.5 * double(height_);
-  const double tan2 = 1.0 / double(view.proj[0][0] * view.proj[0][0]) + 1.0 / double(view.proj[1][1] * view.proj[1][1]);
-  const double per_unit = std::max(fx, fy) * std::sqrt(1.0 + tan2) * stretch;  // texels per object unit at depth 1
+  const LensReach lens = lens_of(view, width_, height_);
+  const double per_unit = lens.texels_per_unit * std::sqrt(1.0 + lens.tan2) * stretch;  // texels per object unit at depth 1
   // View depth of an object-space point: -(row 2 of view * object_to_world) . (p, 1).
   const glm::dmat4 to_eye = glm::dmat4(view.view) * glm::dmat4(object_to_world);
   const glm::dvec3 depth_axis(-to_eye[0][2], -to_eye[1][2], -to_eye[2][2]);
@@ -498,15 +510,12 @@ std::size_t OcclusionBuffer::polygons_worth_rasterizing(const OccluderMesh& mesh
   // Texels per unit at unit view depth, times 1 + tan^2 of the lens's half
   // angles: off axis a length grows by up to that, and a point at distance
   // d lies at a view depth of at least d / sqrt(1 + tan^2).
-  const double fx = std::abs(double(view.proj[0][0])) * 0.5 * double(width_);
-  const double fy = std::abs(double(view.proj[1][1])) * 0.5 * double(height_);
-  const double tan2 = view.orthographic ? 0.0
-                                        : 1.0 / double(view.proj[0][0] * view.proj[0][0]) +
-                                              1.0 / double(view.proj[1][1] * view.proj[1][1]);
+  const LensReach lens = lens_of(view, width_, height_);
+  const double tan2 = view.orthographic ? 0.0 : lens.tan2;
   const glm::mat3 m(object_to_world);
   const double stretch = std::max({glm::length(m[0]), glm::length(m[1]), glm::length(m[2])});
   const double depth = view.orthographic ? 1.0 : std::max(double(distance(view.eye, bounds)), double(view.near));
-  const double texels_per_unit = stretch * std::max(fx, fy) * (1.0 + tan2) / depth;
+  const double texels_per_unit = stretch * lens.texels_per_unit * (1.0 + tan2) / depth;
   return mesh.count_at_least(float(0.5 / texels_per_unit));
 }
 
