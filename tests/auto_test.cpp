@@ -1,6 +1,7 @@
 // The adaptive culler: its schedule on scripted costs, and the culler
 // switching when a scripted backend's costs change.
 #include "cull/auto.hpp"
+#include "cull/cullers.hpp"
 #include "occull/culler.hpp"
 #include "occull/error.hpp"
 #include "test_util.hpp"
@@ -32,44 +33,90 @@ std::vector<std::size_t> run(detail::AutoSchedule& s, const std::vector<double>&
 
 }  // namespace
 
-TEST(AutoSchedule, TriesEveryCandidateThenKeepsTheCheapest) {
+TEST(AutoSchedule, TriesEveryCandidateAfterAnUncountedFirstFrameThenKeepsTheCheapest) {
   detail::AutoSchedule s(config(), 3);
-  const auto ran = run(s, {5.0, 2.0, 3.0}, 6);
-  EXPECT_EQ(ran, (std::vector<std::size_t>{0, 0, 1, 1, 2, 2}));
+  const auto ran = run(s, {5.0, 2.0, 2.4}, 7);
+  EXPECT_EQ(ran, (std::vector<std::size_t>{0, 0, 0, 1, 1, 2, 2}));
   EXPECT_EQ(s.current(), 1u);
   EXPECT_EQ(s.next(), 1u);
 }
 
-TEST(AutoSchedule, ATryMoreThanTwiceTheBestCostEndsAfterOneFrame) {
+TEST(AutoSchedule, ATryAboveCutTimesTheBestEndsAfterOneFrame) {
   detail::AutoSchedule s(config(), 3);
-  const auto ran = run(s, {2.0, 9.0, 3.0}, 5);
-  EXPECT_EQ(ran, (std::vector<std::size_t>{0, 0, 1, 2, 2}));
+  const auto ran = run(s, {2.0, 9.0, 2.2}, 6);
+  EXPECT_EQ(ran, (std::vector<std::size_t>{0, 0, 0, 1, 2, 2}));
   EXPECT_EQ(s.current(), 0u);
 }
 
-TEST(AutoSchedule, SwitchesWhenAChallengerBecomesCheaperByTheMargin) {
-  detail::AutoSchedule s(config(), 2);
-  run(s, {2.0, 5.0}, 4);
+TEST(AutoSchedule, KeepsTheCheapestFromFrameOnePlusTrialTimesCandidatesOn) {
+  // The documented convergence: with fixed costs, the cheapest runs from
+  // frame 1 + trial x candidates on (until the first retry, period frames later at the earliest).
+  const detail::AutoConfig c = config();
+  std::uint64_t seed = 12345;
+  for (int round = 0; round < 50; ++round) {
+    const std::size_t n = 2 + std::size_t(round % 5);
+    std::vector<double> cost;
+    for (std::size_t i = 0; i < n; ++i) {
+      seed = seed * 6364136223846793005ull + 1442695040888963407ull;
+      cost.push_back(1.0 + double(seed >> 40) / double(1ull << 24) * 4.0);
+    }
+    const std::size_t best = std::size_t(std::min_element(cost.begin(), cost.end()) - cost.begin());
+    detail::AutoSchedule s(c, n);
+    const auto ran = run(s, cost, 1 + c.trial * int(n) + c.period);
+    for (std::size_t k = std::size_t(1 + c.trial * int(n)); k < ran.size(); ++k)
+      ASSERT_EQ(ran[k], best) << "round " << round << ", frame " << k;
+  }
+}
+
+TEST(AutoSchedule, TakesACheaperChallengerWithinTrialPlusSixteenPeriods) {
+  const detail::AutoConfig c = config();
+  detail::AutoSchedule s(c, 2);
+  run(s, {1.0, 9.0}, 3000);  // candidate 1 loses by far, again and again: the longest wait
   ASSERT_EQ(s.current(), 0u);
-  // Candidate 1 gets cheaper: at its next try it takes over.
-  const auto ran = run(s, {2.0, 1.0}, 20);
-  EXPECT_EQ(s.current(), 1u);
-  EXPECT_EQ(s.switches(), 1u);
+  const auto ran = run(s, {1.0, 0.5}, c.trial + 16 * c.period + 1);
+  EXPECT_EQ(s.current(), 1u) << "the cheaper challenger took over within trial + 16 x period frames";
   EXPECT_EQ(ran.back(), 1u);
 }
 
-TEST(AutoSchedule, KeepsTheCurrentWithinTheMargin) {
-  detail::AutoSchedule s(config(), 2);
-  run(s, {2.0, 5.0}, 4);
-  run(s, {2.0, 1.95}, 60);  // 2.5 % cheaper: not enough
-  EXPECT_EQ(s.current(), 0u);
+TEST(AutoSchedule, DoesNotAlternateBetweenTwoEqualCandidates) {
+  // Equal costs that vary by up to 3 % from frame to frame (less than the default margin).
+  detail::AutoSchedule s(detail::AutoConfig{}, 2);
+  std::uint64_t seed = 99;
+  for (int k = 0; k < 5000; ++k) {
+    seed = seed * 6364136223846793005ull + 1442695040888963407ull;
+    s.finished(2.0 * (1.0 + 0.03 * (double(seed >> 40) / double(1ull << 24) * 2.0 - 1.0)));
+  }
   EXPECT_EQ(s.switches(), 0u);
+}
+
+TEST(AutoSchedule, ATryRunsAtMostTrialFramesOfALoserAndOneAboveCut) {
+  const detail::AutoConfig c = config();
+  detail::AutoSchedule s(c, 3);
+  const auto ran = run(s, {1.0, 1.2, 5.0}, 3000);
+  ASSERT_EQ(s.current(), 0u);
+  int tries_of_far_loser = 0;
+  for (std::size_t k = 1; k < ran.size();) {
+    if (ran[k] == 0) {
+      ++k;
+      continue;
+    }
+    std::size_t end = k;
+    while (end < ran.size() && ran[end] == ran[k]) ++end;
+    EXPECT_LE(int(end - k), c.trial) << "try at frame " << k;
+    if (ran[k] == 2) {
+      EXPECT_EQ(end - k, 1u) << "a loser above cut x the best runs one frame, at frame " << k;
+      ++tries_of_far_loser;
+    }
+    k = end;
+  }
+  // Tried at the start, then at 4, 16 (the cap) x period frames apart.
+  EXPECT_LE(tries_of_far_loser, 2 + 3000 / (16 * c.period));
 }
 
 TEST(AutoSchedule, ALosingChallengerIsTriedLessAndLessOften) {
   detail::AutoSchedule s(config(), 2);
-  run(s, {1.0, 9.0}, 4);
-  const auto ran = run(s, {1.0, 9.0}, 400);
+  run(s, {1.0, 1.2}, 5);
+  const auto ran = run(s, {1.0, 1.2}, 400);
   std::vector<int> tries;  // frame of each try's first frame
   for (std::size_t k = 1; k < ran.size(); ++k)
     if (ran[k] == 1 && ran[k - 1] == 0) tries.push_back(int(k));
@@ -77,6 +124,46 @@ TEST(AutoSchedule, ALosingChallengerIsTriedLessAndLessOften) {
   for (std::size_t i = 2; i < tries.size(); ++i)
     EXPECT_GE(tries[i] - tries[i - 1], tries[i - 1] - tries[i - 2]) << "gaps between tries never shrink";
   EXPECT_GE(tries[2] - tries[1], 2 * (tries[1] - tries[0]) - 2);
+}
+
+TEST(AutoSchedule, SwitchesWhenAChallengerBecomesCheaperByTheMargin) {
+  detail::AutoSchedule s(config(), 2);
+  run(s, {2.0, 2.5}, 5);
+  ASSERT_EQ(s.current(), 0u);
+  // Candidate 1 gets cheaper: at its next try it takes over.
+  const auto ran = run(s, {2.0, 1.0}, 60);
+  EXPECT_EQ(s.current(), 1u);
+  EXPECT_EQ(s.switches(), 1u);
+  EXPECT_EQ(ran.back(), 1u);
+}
+
+TEST(AutoSchedule, KeepsTheCurrentWithinTheMargin) {
+  detail::AutoSchedule s(config(), 2);
+  run(s, {2.0, 2.5}, 5);
+  run(s, {2.0, 1.95}, 200);  // 2.5 % cheaper: not enough
+  EXPECT_EQ(s.current(), 0u);
+  EXPECT_EQ(s.switches(), 0u);
+}
+
+TEST(AutoSchedule, AChallengerEstimatedAboveSkipTimesTheCurrentIsNeverTried) {
+  detail::AutoSchedule s(config(), 2);
+  for (int k = 0; k < 1000; ++k) {
+    s.estimate(1, 5.0);  // candidate 1 would cost 5: more than skip (1.5) x 2
+    ASSERT_EQ(s.next(), 0u) << "frame " << k;
+    s.finished(2.0);
+  }
+  EXPECT_EQ(s.tries(), 1u);  // candidate 0's measure at the start only
+}
+
+TEST(AutoSchedule, ADisabledCandidateNeverRuns) {
+  detail::AutoSchedule s(config(), 3);
+  s.disable(0);  // before the first frame
+  auto ran = run(s, {1.0, 2.0, 2.2}, 50);
+  s.disable(1);
+  const auto later = run(s, {1.0, 2.0, 2.2}, 300);
+  ran.insert(ran.end(), later.begin(), later.end());
+  for (std::size_t k = 0; k < ran.size(); ++k) EXPECT_NE(ran[k], 0u) << "frame " << k;
+  for (std::size_t k = 50; k < ran.size(); ++k) EXPECT_EQ(ran[k], 2u) << "frame " << k;
 }
 
 TEST(AutoCuller, SwitchesWhenTheBackendsCostsChange) {
@@ -95,11 +182,12 @@ TEST(AutoCuller, SwitchesWhenTheBackendsCostsChange) {
   const View view = make_view({{0, 0, 0}, 0, 0}, {60.0f, 0.1f, 200.0f}, 64, 64);
   test::ScriptedBackend backend;
   // A frame with queries costs `query_frame` ms, one without `plain_frame`.
+  std::uint64_t switches = 0;
   const auto fly = [&](double query_frame, double plain_frame, int frames) {
     int with_queries = 0;
     for (int k = 0; k < frames; ++k) {
       const std::uint64_t before = backend.stats().queries;
-      (void)culler->render_frame(view, backend);
+      switches += culler->render_frame(view, backend).auto_switches;
       const bool queried = backend.stats().queries > before;
       with_queries += queried ? 1 : 0;
       FrameStats measured;
@@ -112,6 +200,55 @@ TEST(AutoCuller, SwitchesWhenTheBackendsCostsChange) {
   EXPECT_LE(fly(10.0, 5.0, 40), 12) << "auto should mostly run vfc";
   (void)fly(2.0, 5.0, 60);                      // now querying pays
   EXPECT_GE(fly(2.0, 5.0, 40), 30) << "auto should have switched to chcpp";
+  EXPECT_EQ(switches, 1u) << "the frames record the switch";
+}
+
+TEST(AutoCuller, RecordsTheCandidateOfEachFrameAndItsTries) {
+  const Scene scene = test::box_scene({{{-1, -1, -5}, {1, 1, -4}}, {{-1, -1, -9}, {1, 1, -8}}});
+  const Bvh bvh = Bvh::build(scene);
+  Options o;
+  o.set("auto.candidates", "vfc+chcpp");
+  const auto culler = make_culler("auto", {scene, bvh}, o);
+  EXPECT_EQ(culler->choices(), (std::vector<std::string>{"vfc", "chcpp"}));
+  const View view = make_view({{0, 0, 0}, 0, 0}, {60.0f, 0.1f, 200.0f}, 64, 64);
+  test::ScriptedBackend backend;
+  std::vector<std::uint32_t> choice;
+  std::vector<std::uint64_t> tries;
+  for (int k = 0; k < 6; ++k) {
+    const FrameStats s = culler->render_frame(view, backend);
+    choice.push_back(s.auto_choice);
+    tries.push_back(s.auto_tries);
+    FrameStats measured;
+    measured.frame_ms = s.auto_choice == 1 ? 1.0 : 3.0;  // vfc is cheaper
+    culler->frame_finished(measured);
+  }
+  // The uncounted first frame and vfc's try (2 frames), chcpp's try (cut after one frame: 3 > 1.3 x 1), then vfc kept.
+  EXPECT_EQ(choice, (std::vector<std::uint32_t>{1, 1, 1, 2, 1, 1}));
+  EXPECT_EQ(tries, (std::vector<std::uint64_t>{0, 1, 0, 1, 0, 0}));
+}
+
+TEST(AutoCuller, HandsOverTheVisibleSetTheQueryCullersTakeAsTheirLastFrames) {
+  std::vector<Aabb> boxes;
+  for (int i = 0; i < 12; ++i) boxes.push_back({{-1.0f, -1.0f, -5.0f - 3.0f * float(i)}, {1.0f, 1.0f, -4.0f - 3.0f * float(i)}});
+  const Scene scene = test::box_scene(boxes);
+  const Bvh bvh = Bvh::build(scene);
+  const View view = make_view({{0, 0, 0}, 0, 0}, {60.0f, 0.1f, 200.0f}, 64, 64);
+  for (const char* name : {"chc", "chcpp", "chcpp:cpu_test=on"}) {
+    const auto culler = make_culler(name, {scene, bvh});
+    test::ScriptedBackend backend;
+    backend.visible_samples = [](std::span<const Aabb>) { return std::uint64_t(0); };  // every query: hidden
+    for (int k = 0; k < 4; ++k) (void)culler->render_frame(view, backend);
+    backend.rendered.clear();
+    (void)culler->render_frame(view, backend);
+    ASSERT_TRUE(backend.rendered.empty()) << name << ": everything was found hidden";
+    auto* resumable = dynamic_cast<detail::Resumable*>(culler.get());
+    ASSERT_NE(resumable, nullptr) << name;
+    const std::vector<ObjectId> handed{7};
+    resumable->resume_from(handed);
+    (void)culler->render_frame(view, backend);
+    EXPECT_NE(std::find(backend.rendered.begin(), backend.rendered.end(), ObjectId(7)), backend.rendered.end())
+        << name << ": object 7, visible in the frame handed over, is drawn as a previously visible object is";
+  }
 }
 
 TEST(AutoCuller, RejectsItselfAndTheOracleAsCandidates) {

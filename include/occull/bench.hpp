@@ -92,6 +92,11 @@ struct AlgorithmSummary {
   double boxes_tested_per_frame = 0.0;    ///< boxes tested against the occlusion buffer (soc)
   double buffer_texels = 0.0;             ///< the occlusion buffer's texels (soc; median over frames)
   double model_ms_per_frame = 0.0;        ///< cost-model prediction (0 without --model)
+  double auto_tries = 0.0;                ///< auto: tries of a challenger over the run (FrameStats::auto_tries)
+  double auto_switches = 0.0;             ///< auto: changes of the culler kept over the run
+  /// auto: each candidate (Culler::choices(), in order) and the share of
+  /// the frames it ran, over every repeat; empty for the other cullers.
+  std::vector<std::pair<std::string, double>> auto_choices;
   double cpu_us_per_node = 0.0;           ///< culler CPU time per visited node, microseconds (0: no nodes)
   double kernel_ms_per_frame = 0.0;       ///< process CPU time in the kernel (FrameStats::kernel_ms)
   double minor_faults_per_frame = 0.0;    ///< process page faults (FrameStats::minor_faults)

@@ -119,6 +119,11 @@ class Culler {
   /// cpu_test=on), or null. Valid until the next render_frame().
   [[nodiscard]] virtual const OcclusionBuffer* occlusion_buffer() const { return nullptr; }
 
+  /// Optional, for the reports: the candidates an adaptive culler (`auto`)
+  /// chooses among, in the order FrameStats::auto_choice numbers them from
+  /// 1 (the spec each was made from). Empty for the other cullers.
+  [[nodiscard]] virtual std::vector<std::string> choices() const { return {}; }
+
   /// Hands back every query the culler holds, through `backend` (which must
   /// reach the device they were issued on): the answers it can use are read
   /// and kept as its next frame would keep them, so nothing it learned is

@@ -22,6 +22,7 @@
 #include "occull/scene.hpp"
 
 #include <cstdint>
+#include <span>
 #include <vector>
 
 namespace occull {
@@ -57,6 +58,11 @@ class DeviceCulling {
   /// Frees `v`. Precondition: v from create_visibility(), not yet destroyed.
   virtual void destroy_visibility(Visibility v) = 0;
 
+  /// Sets `v` to `visible` (every other object not visible), as if the last
+  /// draw_newly_visible(v) had found exactly those visible: a culler taking
+  /// over another's visibility (auto's hand-over). Ids past the scene are
+  /// ignored. Precondition: v from create_visibility(), not yet destroyed.
+  virtual void set_visible(Visibility v, std::span<const ObjectId> visible) = 0;
   /// Phase 1: draws every opaque object in the frustum whose bit is set in
   /// `v` (those found visible by the last draw_newly_visible(v)). Writes
   /// depth (and whatever else render() writes).

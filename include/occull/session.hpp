@@ -91,6 +91,7 @@ struct AlgorithmRun {
   std::uint32_t longest_miss_frames = 0;  ///< longest run of frames one object stayed missed
   std::vector<MemorySample> memory;       ///< after every kMemorySampleFrames frames
   std::string first_miss;                 ///< "frame K: <describe_object>" of the first missed object; empty if none
+  std::vector<std::string> choices;       ///< the culler's Culler::choices() (auto's candidates), numbered by FrameStats::auto_choice
 };
 
 /// How long objects stay missed over consecutive frames of one run.

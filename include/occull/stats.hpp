@@ -46,6 +46,11 @@ struct FrameStats {
   std::uint64_t boxes_tested = 0;        ///< node and object boxes tested against the buffer
   std::uint64_t buffer_texels = 0;       ///< the buffer's width × height
 
+  // The adaptive culler (auto): which candidate ran, and its decisions.
+  std::uint32_t auto_choice = 0;   ///< 1 + index in Culler::choices() of the candidate auto ran this frame; 0: not auto
+  std::uint64_t auto_tries = 0;    ///< 1 on the first frame of a try of a challenger (not the culler auto keeps)
+  std::uint64_t auto_switches = 0; ///< 1 on the first frame of a new culler kept (it won its try)
+
   // Tiled worlds (tilevfc, pertile, tiles; Gomez et al. 2013).
   std::uint64_t tiles_rendered = 0;      ///< tile instances drawn (culled inside by their own culler, if any)
   std::uint64_t tile_queries = 0;        ///< queries of the common box at a tile (tiles)

@@ -1,15 +1,37 @@
 // `auto`: the adaptive culler. No culler wins everywhere: where occlusion is
 // scarce (open ground, small maps, thousands of tiny meshes) queries cost
 // more than they save and plain view-frustum culling is fastest; in a city
-// CHC++ or NOHC save most of the frame. `auto` runs one of its candidates
-// per frame for its view, learns what each costs here from the frames it
-// measured (Culler::frame_finished: the owner's frame time, or else its own
-// time in render_frame), and keeps the cheapest with hysteresis
-// (AutoSchedule). Every candidate is conservative, so `auto` is.
+// CHC++, CHC, NOHC, the CPU occlusion buffer or the depth pyramid save most
+// of the frame, and which of them is cheapest depends on the scene and the
+// device. `auto` runs one of its candidates per frame for its view, learns
+// what each costs here from the frames it measured (Culler::frame_finished:
+// the owner's frame time, or else its own time in render_frame), per unit
+// of frame content, and keeps the cheapest with hysteresis (AutoSchedule,
+// auto.hpp). Every candidate is conservative, so `auto` is.
 //
-// Each candidate keeps its own temporal state; one that was not run for a
-// while finds its coherence stale and rebuilds it in its first frame back;
-// that frame counts against it, and switching needs a margin.
+// Switching, and what it keeps warm. A candidate that did not run last
+// frame holds the temporal state of its own last frame (a temporal culler
+// counts its own frames: to it, its last frame was the one before). The
+// policy (hand_over below):
+//   - Back after at most kFreshFrames frames (the current after a try of
+//     another), a candidate goes on from its own state: a few frames old,
+//     it is tighter than a challenger's (measured: CHC++ handed a cold
+//     NOHC's visible set spent 6 frames at up to 3x its cost getting rid of
+//     the extra objects, a CHC++ visible leaf being queried again only
+//     after some frames).
+//   - Back after longer, or never run, a Resumable candidate (chc, chcpp,
+//     nohc, hiz) is handed the visibility of the frame before: the objects
+//     the previous candidate drew (Culler::drawn_objects(), the visible set
+//     every culler shares), when that one culled by occlusion (drew fewer
+//     objects than the frustum holds). chc, chcpp, nohc rebuild their node
+//     states from it as after a rebuilt hierarchy (carry_over); hiz's phase
+//     1 draws it. Conservative whatever the set says: queries or the depth
+//     pyramid test what it calls hidden. After vfc (it drew the whole
+//     frustum) or hiz (its drawn set stays on the device) there is nothing
+//     to hand over, and the candidate resumes from its own state.
+//   - soc and vfc keep no state across frames: nothing to keep warm.
+//   - What a switch still costs is priced in: every frame a candidate runs
+//     is measured, the first one of a try included.
 #include "auto.hpp"
 
 #include "cullers.hpp"
@@ -24,69 +46,143 @@
 namespace occull::detail {
 
 AutoSchedule::AutoSchedule(AutoConfig config, std::size_t candidates)
-    : config_(std::move(config)), count_(candidates), cost_(candidates, 0.0), losses_(candidates, 0),
-      next_try_(candidates, 0) {
-  start_trial(0);
-}
+    : config_(std::move(config)), count_(candidates), cost_(candidates, 0.0), estimate_(candidates, 0.0),
+      losses_(candidates, 0), next_try_(candidates, 0), disabled_(candidates, false) {}
 
 void AutoSchedule::start_trial(std::size_t c) {
   running_ = c;
   in_trial_ = true;
   trial_frame_ = 0;
   samples_.clear();
+  if (!cold_) ++tries_;
 }
 
-void AutoSchedule::end_trial() {
-  std::vector<double> s = samples_;
-  std::nth_element(s.begin(), s.begin() + std::ptrdiff_t(s.size() / 2), s.end());
-  const double measured = s.empty() ? 0.0 : s[s.size() / 2];
+void AutoSchedule::disable(std::size_t c) {
+  disabled_[c] = true;
+  const auto first_enabled = [&] {
+    return std::size_t(std::find(disabled_.begin(), disabled_.end(), false) - disabled_.begin());
+  };
+  if (cold_) {  // before the first frame: the first candidate that may run starts
+    if (running_ == c) running_ = first_enabled();
+    return;
+  }
+  if (!initial_ && current_ == c) {  // the cheapest measured of the others is kept
+    current_ = count_;
+    for (std::size_t i = 0; i < count_; ++i)
+      if (!disabled_[i] && cost_[i] > 0.0 && (current_ == count_ || cost_[i] < cost_[current_])) current_ = i;
+    if (current_ == count_) current_ = first_enabled();
+  }
+  if (running_ != c) return;
+  in_trial_ = false;  // it was about to run: what comes after it does
+  if (initial_)
+    after_initial(c);
+  else
+    running_ = current_;
+}
+
+void AutoSchedule::estimate(std::size_t c, double cost) { estimate_[c] = cost; }
+
+double AutoSchedule::reference(std::size_t c) const {
+  if (!initial_) return cost_[current_];
+  double best = 0.0;  // the start's round: the cheapest of the others measured so far
+  for (std::size_t i = 0; i < count_; ++i)
+    if (i != c && cost_[i] > 0.0 && (best == 0.0 || cost_[i] < best)) best = cost_[i];
+  return best;
+}
+
+bool AutoSchedule::hopeless(std::size_t c) const {
+  const double against = reference(c);
+  return estimate_[c] > 0.0 && against > 0.0 && estimate_[c] > config_.skip * against;
+}
+
+void AutoSchedule::lost(std::size_t c, std::uint32_t by) {
+  losses_[c] = std::min<std::uint32_t>(losses_[c] + by, 4);
+  next_try_[c] = frame_ + (std::uint64_t(config_.period) << losses_[c]);
+}
+
+void AutoSchedule::end_trial(bool cut) {
+  double sum = 0.0;
+  for (double s : samples_) sum += s;
+  const double measured = samples_.empty() ? 0.0 : sum / double(samples_.size());
   const std::size_t c = running_;
-  cost_[c] = measured;
   in_trial_ = false;
   if (initial_) {
-    if (c + 1 < count_) {
-      start_trial(c + 1);
-      return;
-    }
-    initial_ = false;
-    current_ = std::size_t(std::min_element(cost_.begin(), cost_.end()) - cost_.begin());
-    for (std::size_t i = 0; i < count_; ++i) next_try_[i] = frame_ + std::uint64_t(config_.period);
-  } else if (c != current_) {
-    if (measured < cost_[current_] * (1.0 - config_.margin)) {
-      current_ = c;
-      losses_[c] = 0;
-      ++switches_;
-    } else {
-      losses_[c] = std::min<std::uint32_t>(losses_[c] + 1, 4);
-    }
-    next_try_[c] = frame_ + (std::uint64_t(config_.period) << losses_[c]);
+    cost_[c] = measured;
+    after_initial(c);
+    return;
+  }
+  if (measured < cost_[current_] * (1.0 - config_.margin)) {
+    next_try_[current_] = frame_ + (std::uint64_t(config_.period) << losses_[current_]);
+    cost_[c] = measured;
+    current_ = c;
+    losses_[c] = 0;
+    ++switches_;
+    switched_ = true;
+  } else {
+    cost_[c] = measured;
+    lost(c, cut ? 2 : 1);  // lost by far: its next try waits four times as long
   }
   running_ = current_;
 }
 
-void AutoSchedule::finished(double cost_ms) {
-  ++frame_;
-  if (in_trial_) {
-    // The first frame after a switch also rebuilds the candidate's stale
-    // temporal state: a real cost of switching, so it is counted.
-    samples_.push_back(cost_ms);
-    // A try whose frame already costs more than twice the best known one
-    // ends at once: in a dense city one frame of plain frustum culling can
-    // cost as much as a dozen of CHC++'s.
-    double best = 0.0;
+void AutoSchedule::after_initial(std::size_t c) {
+  for (std::size_t n = c + 1; n < count_; ++n) {
+    if (disabled_[n]) continue;
+    if (hopeless(n)) {
+      lost(n, 2);
+      continue;
+    }
+    start_trial(n);
+    return;
+  }
+  // Every candidate measured (or skipped): keep the cheapest.
+  initial_ = false;
+  current_ = count_;
+  for (std::size_t i = 0; i < count_; ++i)
+    if (!disabled_[i] && cost_[i] > 0.0 && (current_ == count_ || cost_[i] < cost_[current_])) current_ = i;
+  if (current_ == count_)  // nothing measured (every try disabled at once): the first that may run
+    current_ = std::size_t(std::find(disabled_.begin(), disabled_.end(), false) - disabled_.begin());
+  // The others lost their try of the round: by far (more than cut x) counts twice, as a try cut short does.
+  for (std::size_t i = 0; i < count_; ++i)
+    if (i != current_ && cost_[i] > 0.0) lost(i, cost_[i] > config_.cut * cost_[current_] ? 2 : 1);
+  running_ = current_;
+}
+
+void AutoSchedule::choose_next() {
+  // Tries due, the one waiting longest first; a hopeless one loses untried.
+  for (;;) {
+    std::size_t due = count_;
     for (std::size_t i = 0; i < count_; ++i)
-      if (i != running_ && cost_[i] > 0.0 && (best == 0.0 || cost_[i] < best)) best = cost_[i];
-    const bool hopeless = best > 0.0 && cost_ms > 2.0 * best;
-    if (++trial_frame_ >= config_.trial || hopeless) end_trial();
+      if (i != current_ && !disabled_[i] && next_try_[i] <= frame_ && (due == count_ || next_try_[i] < next_try_[due]))
+        due = i;
+    if (due == count_) return;
+    if (!hopeless(due)) {
+      start_trial(due);
+      return;
+    }
+    lost(due, 2);
+  }
+}
+
+void AutoSchedule::finished(double cost) {
+  ++frame_;
+  switched_ = false;
+  if (cold_) {  // every culler's first frame builds its state from nothing: not a measure of it
+    cold_ = false;
+    start_trial(running_);
+    return;
+  }
+  if (in_trial_) {
+    samples_.push_back(cost);
+    ++trial_frame_;
+    const double against = reference(running_);
+    const bool cut = trial_frame_ == 1 && against > 0.0 && cost > config_.cut * against;
+    if (trial_frame_ >= config_.trial || cut) end_trial(cut);
     return;
   }
   // The current culler: a running cost, so it follows the scene.
-  cost_[current_] += config_.smoothing * (cost_ms - cost_[current_]);
-  // Time to try a challenger? The one waiting longest past its turn.
-  std::size_t best = count_;
-  for (std::size_t i = 0; i < count_; ++i)
-    if (i != current_ && next_try_[i] <= frame_ && (best == count_ || next_try_[i] < next_try_[best])) best = i;
-  if (best != count_) start_trial(best);
+  cost_[current_] += config_.smoothing * (cost - cost_[current_]);
+  choose_next();
 }
 
 namespace {
@@ -98,52 +194,181 @@ namespace {
 // what they did with the frame rather than on what the frame held.
 constexpr double kTrianglesPerDraw = 64.0;
 
+// A candidate back after at most this many frames goes on from its own state.
+constexpr std::uint64_t kFreshFrames = 4;
+
+// The content of every subtree, so that a node inside the frustum counts at
+// once: measuring a view costs a frustum traversal down to the nodes its
+// planes cut, not a walk over every object in it.
+class FrustumContent {
+ public:
+  explicit FrustumContent(const SceneIndex& index) : index_(index) {}
+
+  struct Measure {
+    double content = 0.0;      ///< triangles + kTrianglesPerDraw x objects
+    std::size_t objects = 0;   ///< objects in the frustum
+  };
+
+  Measure operator()(const View& view) {
+    refresh();
+    Measure m;
+    add(Bvh::root(), Frustum::all_planes, view, m);
+    m.content = std::max(1.0, m.content);
+    return m;
+  }
+
+ private:
+  static double of(const Object& o) { return double(o.triangles) + kTrianglesPerDraw; }
+
+  void refresh() {
+    const Bvh& bvh = index_.bvh;
+    if (known_ && generation_ == bvh.generation() && layout_ == index_.scene.layout_revision()) return;
+    known_ = true;
+    generation_ = bvh.generation();
+    layout_ = index_.scene.layout_revision();
+    subtree_.assign(bvh.size(), 0.0);
+    // Children come after their parent (Bvh::left(n) is n + 1): sum upwards.
+    for (NodeId n = NodeId(bvh.size()); n-- > 0;) {
+      if (bvh.is_leaf(n))
+        for (ObjectId id : bvh.objects(n)) subtree_[n] += of(index_.scene.object(id));
+      if (bvh.node(n).parent != kNoNode) subtree_[bvh.node(n).parent] += subtree_[n];
+    }
+  }
+
+  void add(NodeId n, std::uint32_t planes, const View& view, Measure& m) const {
+    const Bvh& bvh = index_.bvh;
+    if (bvh.node(n).object_count == 0) return;
+    if (planes != 0 && view.frustum.classify(bvh.node(n).bounds, planes) == Containment::outside) return;
+    if (planes == 0) {  // inside: the whole subtree
+      m.content += subtree_[n];
+      m.objects += bvh.node(n).object_count;
+      return;
+    }
+    if (bvh.is_leaf(n)) {
+      for (ObjectId id : bvh.objects(n)) {
+        const Object& o = index_.scene.object(id);
+        std::uint32_t mask = planes;
+        if (o.bounds.empty() || view.frustum.classify(o.bounds, mask) == Containment::outside) continue;
+        m.content += of(o);
+        ++m.objects;
+      }
+      return;
+    }
+    add(Bvh::left(n), planes, view, m);
+    add(bvh.right(n), planes, view, m);
+  }
+
+  SceneIndex index_;
+  std::vector<double> subtree_;
+  std::uint64_t generation_ = 0;
+  std::uint64_t layout_ = 0;
+  bool known_ = false;
+};
+
+struct Candidate {
+  std::string spec;
+  std::unique_ptr<Culler> culler;
+  bool device = false;     // culls on the device (hiz): needs Backend::device_culling()
+  bool frustum = false;    // draws the whole frustum (vfc): its cost is estimated from others' frames
+  std::uint64_t last_frame = 0;  // auto's frame it last ran (0: never)
+};
+
 class AutoCuller final : public Culler {
  public:
-  AutoCuller(const SceneIndex& index, std::vector<std::unique_ptr<Culler>> candidates, const AutoConfig& config)
-      : index_(index), candidates_(std::move(candidates)), schedule_(config, candidates_.size()) {}
+  AutoCuller(const SceneIndex& index, std::vector<Candidate> candidates, const AutoConfig& config)
+      : content_of_(index), candidates_(std::move(candidates)), schedule_(config, candidates_.size()) {}
 
   FrameStats cull(const View& view, Backend& backend) override {
-    if (awaiting_feedback_) schedule_.finished(own_ms_ / content_);  // the owner did not call frame_finished
-    in_frustum_.clear();
-    FrameStats ignored;
-    collect_in_frustum_front_to_back(index_, view, in_frustum_, ignored);
-    double triangles = 0.0;
-    for (ObjectId id : in_frustum_) triangles += double(index_.scene.object(id).triangles);
-    content_ = std::max(1.0, triangles + kTrianglesPerDraw * double(in_frustum_.size()));
-    running_ = schedule_.next();
+    if (!started_) start(backend);
+    if (awaiting_feedback_) finished(FrameStats{});  // the owner did not call frame_finished
+    const FrustumContent::Measure frustum = content_of_(view);
+    content_ = frustum.content;
+    const std::size_t run = schedule_.next();
+    if (run != last_ && last_ < candidates_.size()) hand_over(last_, run, frustum.objects);
+    candidates_[run].last_frame = ++frame_;
+    const bool tried = schedule_.starts_try(), switched = schedule_.just_switched();
     const auto t0 = std::chrono::steady_clock::now();
-    FrameStats s = candidates_[running_]->render_frame(view, backend);
+    FrameStats s = candidates_[run].culler->render_frame(view, backend);
     own_ms_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    last_ = run;
     awaiting_feedback_ = true;
+    s.auto_choice = std::uint32_t(run + 1);
+    s.auto_tries = tried ? 1 : 0;
+    s.auto_switches = switched ? 1 : 0;
     return s;
   }
 
   void frame_finished(const FrameStats& measured) override {
-    candidates_[running_]->frame_finished(measured);
-    if (!awaiting_feedback_) return;
-    awaiting_feedback_ = false;
-    schedule_.finished((measured.frame_ms > 0.0 ? measured.frame_ms : own_ms_) / content_);
+    candidates_[last_].culler->frame_finished(measured);
+    if (awaiting_feedback_) finished(measured);
+  }
+
+  [[nodiscard]] std::vector<std::string> choices() const override {
+    std::vector<std::string> specs;
+    for (const Candidate& c : candidates_) specs.push_back(c.spec);
+    return specs;
   }
 
   void release(Backend& backend) override {
-    for (auto& c : candidates_) c->release(backend);
+    for (Candidate& c : candidates_) c.culler->release(backend);
   }
   [[nodiscard]] std::size_t queries_held() const override {
     std::size_t n = 0;
-    for (const auto& c : candidates_) n += c->queries_held();
+    for (const Candidate& c : candidates_) n += c.culler->queries_held();
     return n;
   }
 
  private:
-  SceneIndex index_;
-  std::vector<ObjectId> in_frustum_;
+  // The first frame: candidates that cannot run on this backend never will.
+  void start(Backend& backend) {
+    started_ = true;
+    std::size_t left = candidates_.size();
+    for (std::size_t c = 0; c < candidates_.size(); ++c)
+      if (candidates_[c].device && !backend.device_culling() && left > 1) {
+        schedule_.disable(c);
+        --left;
+      }
+  }
+
+  // The frame's cost reaches the schedule; with the owner's measure (frame
+  // time, and its parts), vfc's cost is estimated too: it would draw the
+  // frustum at the cost per unit drawn of this frame (the frame's time less
+  // the culler's CPU and query waits, over what it drew). The estimate errs
+  // high (fixed costs of the frame count as drawing), so it only spares a
+  // try where vfc would lose by far (a dense city), never decides a switch.
+  void finished(const FrameStats& measured) {
+    awaiting_feedback_ = false;
+    const double drawn = double(measured.triangles) + kTrianglesPerDraw * double(measured.draw_calls);
+    if (measured.frame_ms > 0.0 && drawn > 0.0 && !candidates_[last_].frustum) {
+      const double per_unit = std::max(0.0, measured.frame_ms - measured.cpu_ms - measured.wait_ms) / drawn;
+      for (std::size_t c = 0; c < candidates_.size(); ++c)
+        if (candidates_[c].frustum) schedule_.estimate(c, per_unit);
+    }
+    schedule_.finished((measured.frame_ms > 0.0 ? measured.frame_ms : own_ms_) / content_);
+  }
+
+  // `to` runs after `from` ran last frame: hands it the visibility `from`
+  // found, when `to` has been away long or never ran, `from` culled by
+  // occlusion and `to` can take it (the policy at the top of this file).
+  void hand_over(std::size_t from, std::size_t to, std::size_t in_frustum) {
+    const std::uint64_t last = candidates_[to].last_frame;
+    if (last != 0 && frame_ - last <= kFreshFrames) return;  // its own state is fresher
+    auto* resumable = dynamic_cast<Resumable*>(candidates_[to].culler.get());
+    if (!resumable) return;
+    const std::span<const ObjectId> drawn = candidates_[from].culler->drawn_objects();
+    if (drawn.empty() || drawn.size() >= in_frustum) return;
+    resumable->resume_from(drawn);
+  }
+
+  FrustumContent content_of_;
   double content_ = 1.0;
-  std::vector<std::unique_ptr<Culler>> candidates_;
+  std::vector<Candidate> candidates_;
   AutoSchedule schedule_;
-  std::size_t running_ = 0;
+  std::size_t last_ = std::size_t(-1);  // the candidate run in the last frame
+  std::uint64_t frame_ = 0;             // frames run, counting from 1
   double own_ms_ = 0.0;
   bool awaiting_feedback_ = false;
+  bool started_ = false;
 };
 
 }  // namespace
@@ -153,18 +378,21 @@ Registration auto_registration() {
   static const ConfigTable<C> table =
       ConfigTable<C>()
           .text("candidates", &C::candidates,
-                "cullers to choose among, joined by +, tried in this order (by default nohc only where a profile is at "
-                "hand, as occull bench has)")
-          .integer("trial", &C::trial, 1, 1000,
-                   "frames a candidate runs when tried (its cost: their median, per unit of frame content)")
+                "cullers to choose among, joined by +, tried in this order (by default every conservative one: nohc "
+                "only where a profile is at hand, as occull bench has; hiz only on a backend with device culling)")
+          .integer("trial", &C::trial, 1, 1000, "frames a try of a candidate runs at most (its cost: their mean)")
           .integer("period", &C::period, 1, 1000000,
                    "frames between tries of a challenger (doubled after each lost try, up to 16x)")
           .real("margin", &C::margin, 0.0, 0.9,
-                "a challenger must be this much cheaper to take over (frame times of one culler vary more than 5 % "
-                "between frames)");
+                "a challenger must be this much cheaper to take over (frame times of one culler vary by a few "
+                "percent between frames)")
+          .real("cut", &C::cut, 1.0, 100.0,
+                "a try whose first frame costs more than this times the current culler's ends after that frame")
+          .real("skip", &C::skip, 1.0, 100.0,
+                "vfc is not tried while its estimated cost is above this times the current culler's");
   return registered(
-      {"auto", "adaptive: runs the cheapest of chcpp, vfc and nohc for this view, learnt from the measured frame "
-               "times, with hysteresis"},
+      {"auto", "adaptive: runs the cheapest of its candidates (every conservative culler) for this view, learnt "
+               "from the measured frame times, with hysteresis"},
       table, [](const SceneIndex& index, const C& c, const Options& o, const CullerContext& context) {
         std::vector<std::string> names;
         for (std::string_view rest = c.candidates; !rest.empty();) {
@@ -176,13 +404,16 @@ Registration auto_registration() {
         if (!o.has("auto.candidates") && !o.has("nohc.profile") && !has_nohc_profile(context))
           std::erase(names, "nohc");
         if (names.empty()) throw InputError("option auto.candidates: no candidate given (e.g. chcpp+vfc+nohc)");
-        std::vector<std::unique_ptr<Culler>> cullers;
+        std::vector<Candidate> candidates;
         for (const std::string& name : names) {
-          if (name == "auto" || name == "oracle")
-            throw InputError(fmt::format("option auto.candidates: '{}' cannot be a candidate", name));
-          cullers.push_back(make_culler(name, index, o, context));
+          const AlgorithmInfo& info = find_algorithm(parse_algorithm_spec(name, o).name);
+          if (info.name == "auto" || info.harness_only || !info.conservative)
+            throw InputError(fmt::format("option auto.candidates: '{}' cannot be a candidate (auto runs conservative "
+                                         "cullers other than itself)",
+                                         name));
+          candidates.push_back({name, make_culler(name, index, o, context), info.device, info.name == "vfc"});
         }
-        return std::make_unique<AutoCuller>(index, std::move(cullers), c);
+        return std::make_unique<AutoCuller>(index, std::move(candidates), c);
       });
 }
 

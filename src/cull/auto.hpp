@@ -9,54 +9,93 @@
 namespace occull::detail {
 
 struct AutoConfig {
-  // Tried in this order at the start: chcpp first, so that a candidate far
-  // worse than it (vfc in a dense city) is dropped after one frame.
-  std::string candidates = "chcpp+vfc+nohc";  ///< joined by +
-  int trial = 2;          ///< frames a candidate runs when tried (its cost: their median)
-  int period = 50;        ///< frames between tries of a challenger
-  double margin = 0.15;   ///< a challenger must be this much cheaper to take over (hysteresis)
-  double smoothing = 0.15;  ///< weight of the newest frame in the running cost of the current culler
+  /// Candidates, joined by +, tried in this order at the start (chc first:
+  /// from nothing it settles in one frame, CHC++ in several, and the next
+  /// ones start from its visible set). By default
+  /// every conservative culler that may run: nohc only where a profile is
+  /// at hand, hiz only on a backend with device culling (auto.cpp).
+  std::string candidates = "chc+chcpp+nohc+soc+hiz+vfc";
+  int trial = 2;           ///< frames a try runs at most (its cost: their mean)
+  int period = 40;         ///< frames before a challenger's next try; doubled after each lost try, up to 16x
+  double margin = 0.08;    ///< a challenger must be this much cheaper than the current to take over (hysteresis)
+  double cut = 1.3;        ///< a try whose first frame costs more than this times the current's cost ends there
+  double skip = 1.5;       ///< a challenger estimated above this times the current's cost is not tried (a lost try)
+  double smoothing = 0.15; ///< weight of the newest frame in the running cost of the current culler
 };
 
 /// Which candidate runs each frame, from the measured cost of the frames
-/// run so far. Starts by trying each candidate in order; then keeps the
-/// cheapest, tries another one every `period` frames for `trial` frames and
-/// switches when it was cheaper by `margin`. A try whose frame costs more
-/// than twice the best known cost ends after that frame. A challenger that loses waits
-/// twice as long before its next try (up to 16 periods), so a candidate
-/// that never pays costs almost nothing to keep watching.
+/// run so far (any unit, the same for every frame; auto passes
+/// milliseconds per unit of frame content).
+///
+/// Start: the first frame runs candidate 0 and is not counted (every
+/// culler starts cold); then each candidate is tried in order, and the
+/// cheapest is kept ("the current"). So with fixed costs the schedule runs
+/// the cheapest from frame 1 + trial x candidates on.
+///
+/// A try of a challenger runs `trial` frames, or one when that frame costs
+/// more than `cut` x the current's cost: no try costs more than `trial`
+/// frames of a loser, and a loser that costs more than `cut` x the best
+/// costs one frame. A try is skipped (and counts as lost) when the
+/// challenger's estimate (estimate(); auto gives one for vfc, whose frame
+/// is predictable: it draws the frustum) exceeds `skip` x the current's.
+/// The challenger takes over when its try's mean is below (1 - margin) x
+/// the current's running cost; two candidates of equal cost therefore do
+/// not alternate. A challenger that loses waits twice as long for its next
+/// try (period, 2, 4, ... 16 x period frames; one cut after its first frame
+/// or skipped as hopeless, four times as long): after the costs change, the
+/// cheaper candidate is kept within trial + 16 x period frames.
 class AutoSchedule {
  public:
   AutoSchedule(AutoConfig config, std::size_t candidates);
 
   /// The candidate to run in the next frame.
   [[nodiscard]] std::size_t next() const noexcept { return running_; }
-  /// Reports the cost of the frame just run by next() (any unit, the same
-  /// for every frame: auto passes milliseconds per unit of frame content)
-  /// and chooses the next frame's candidate.
-  void finished(double cost_ms);
+  /// Whether next() runs the first frame of a try (the start's round
+  /// included: every candidate's first measured frame).
+  [[nodiscard]] bool starts_try() const noexcept { return in_trial_ && !cold_ && trial_frame_ == 0; }
+  /// Whether the last finished() made a challenger the current.
+  [[nodiscard]] bool just_switched() const noexcept { return switched_; }
+  /// Reports the cost of the frame just run by next() and chooses the next
+  /// frame's candidate.
+  void finished(double cost);
+  /// Never runs candidate `c` again (it cannot run here: hiz on a backend
+  /// without device culling). Precondition: some other candidate remains.
+  void disable(std::size_t c);
+  /// An estimate of candidate `c`'s cost now, in finished()'s unit (0: none).
+  void estimate(std::size_t c, double cost);
 
   [[nodiscard]] std::size_t current() const noexcept { return current_; }  ///< the one kept between tries
   [[nodiscard]] std::uint64_t switches() const noexcept { return switches_; }
+  [[nodiscard]] std::uint64_t tries() const noexcept { return tries_; }     ///< tries of challengers run
   [[nodiscard]] double cost(std::size_t c) const { return cost_[c]; }      ///< 0 until measured
 
  private:
   void start_trial(std::size_t c);
-  void end_trial();
+  void end_trial(bool cut);  // cut: after its first frame, which cost more than cut x
+  void after_initial(std::size_t c);  // the try of candidate c in the initial round ended
+  void choose_next();
+  void lost(std::size_t c, std::uint32_t by = 1);  // c lost a try (or skipped one): its next comes later
+  [[nodiscard]] double reference(std::size_t c) const;  // the cost a try of c is measured against
+  [[nodiscard]] bool hopeless(std::size_t c) const;  // its estimate skips its try
 
   AutoConfig config_;
   std::size_t count_;
-  std::vector<double> cost_;       // running cost of the current one; last trial's median of others
+  std::vector<double> cost_;       // running cost of the current one; last try's mean of the others
+  std::vector<double> estimate_;   // 0: none
   std::vector<std::uint32_t> losses_;
   std::vector<std::uint64_t> next_try_;
-  std::vector<double> samples_;    // the trial's counted frames
+  std::vector<bool> disabled_;
+  std::vector<double> samples_;    // the try's frames
   std::size_t current_ = 0;
   std::size_t running_ = 0;
   bool in_trial_ = true;
-  bool initial_ = true;            // trying every candidate once at the start
+  bool initial_ = true;            // the first round: every candidate once
+  bool cold_ = true;               // the very first frame: not counted
+  bool switched_ = false;
   int trial_frame_ = 0;
   std::uint64_t frame_ = 0;
   std::uint64_t switches_ = 0;
+  std::uint64_t tries_ = 0;
 };
 
 }  // namespace occull::detail

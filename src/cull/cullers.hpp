@@ -4,6 +4,8 @@
 
 #include "config_table.hpp"
 
+#include <span>
+
 namespace occull::detail {
 
 Registration none_registration();
@@ -20,6 +22,20 @@ Registration auto_registration();
 Registration tilevfc_registration();
 Registration pertile_registration();
 Registration tiles_registration();
+
+/// A culler that can start its next frame from another culler's visible
+/// set (auto's hand-over: chc, chcpp, nohc, hiz). `drawn` is what the other
+/// culler drew in the frame before (Culler::drawn_objects()); the next
+/// render_frame() takes it as its own last frame's visibility. Any set is
+/// conservative: what it claims hidden is tested (queried or tested
+/// against a depth pyramid) before it is culled.
+class Resumable {
+ public:
+  virtual void resume_from(std::span<const ObjectId> drawn) = 0;
+
+ protected:
+  ~Resumable() = default;
+};
 
 /// nohc's hardware profile for a culler: the file `file` names (the option
 /// nohc.profile), else `context.nohc_profile`, else

@@ -30,17 +30,25 @@ struct HizConfig {
   int texels = 8;
 };
 
-class HizCuller final : public Culler {
+class HizCuller final : public Culler, public Resumable {
  public:
   explicit HizCuller(const HizConfig& config) : config_(config) {}
 
   FrameStats cull(const View&, Backend& backend) override {
     DeviceCulling& device = device_of(backend);
     if (!visibility_) visibility_ = device.create_visibility();
+    if (resume_) device.set_visible(*visibility_, handed_over_);
+    resume_ = false;
     device.draw_previously_visible(*visibility_);
     device.build_depth_pyramid();
     device.draw_newly_visible(*visibility_, config_.texels);
     return {};
+  }
+
+  // Phase 1 of the next frame draws `drawn` (auto's hand-over).
+  void resume_from(std::span<const ObjectId> drawn) override {
+    handed_over_.assign(drawn.begin(), drawn.end());
+    resume_ = true;
   }
 
   void release(Backend& backend) override {
@@ -61,6 +69,8 @@ class HizCuller final : public Culler {
 
   HizConfig config_;
   std::optional<DeviceCulling::Visibility> visibility_;
+  std::vector<ObjectId> handed_over_;
+  bool resume_ = false;
 };
 
 }  // namespace

@@ -5,9 +5,11 @@
 
 #include "occull/bvh.hpp"
 #include "config_table.hpp"
+#include "cullers.hpp"
 #include "occull/cpu_test_backend.hpp"
 #include "occull/culler.hpp"
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <memory>
@@ -85,6 +87,11 @@ class ObjectVisibility {
   }
   void drawn(std::span<const ObjectId> objects, std::uint32_t frame) {
     for (ObjectId id : objects) drawn_[id] = frame;
+  }
+  /// Forgets what was recorded for `frame` and records `objects` instead.
+  void replace(std::span<const ObjectId> objects, std::uint32_t frame) {
+    std::replace(drawn_.begin(), drawn_.end(), frame, kNever);
+    drawn(objects, frame);
   }
   [[nodiscard]] bool drawn_in(ObjectId id, std::uint32_t frame) const {
     return id < drawn_.size() && drawn_[id] == frame;
@@ -262,7 +269,7 @@ struct CommonOptions {
 /// A query culler whose frames run through the CPU first test when its
 /// options ask for it (CommonOptions::cpu_test; occull/cpu_test_backend.hpp):
 /// the culler's cull_frame() sees a CpuTestBackend over the frame's backend.
-class CpuTestedCuller : public Culler {
+class CpuTestedCuller : public Culler, public Resumable {
  public:
   CpuTestedCuller(const SceneIndex& index, const CommonOptions& options)
       : cpu_test_(options.cpu_test ? std::make_unique<CpuTestBackend>(index.scene) : nullptr) {}
@@ -278,12 +285,32 @@ class CpuTestedCuller : public Culler {
     return cpu_test_ ? cpu_test_->buffer() : nullptr;
   }
 
+  /// Hand-over (auto, Resumable): the next frame starts from `drawn` as if
+  /// this culler had drawn it in its own last frame; its node states are
+  /// rebuilt from it (carry_over).
+  void resume_from(std::span<const ObjectId> drawn) final {
+    handed_over_.assign(drawn.begin(), drawn.end());
+    resume_ = true;
+  }
+
  protected:
+  /// At the start of a frame (after `seen.begin`): records a hand-over as
+  /// drawn in `last_frame` and says whether there was one (the caller then
+  /// rebuilds its states with carry_over, as after a rebuilt hierarchy).
+  bool take_hand_over(ObjectVisibility& seen, std::uint32_t last_frame) {
+    if (!resume_) return false;
+    resume_ = false;
+    seen.replace(handed_over_, last_frame);
+    return true;
+  }
+
   /// The culler's frame, through the first test when it is on.
   virtual FrameStats cull_frame(const View& view, Backend& backend) = 0;
 
  private:
   std::unique_ptr<CpuTestBackend> cpu_test_;
+  std::vector<ObjectId> handed_over_;
+  bool resume_ = false;
 };
 
 /// Adds the fields of the CommonOptions at `at` (see ConfigTable) to `table`.

@@ -104,6 +104,7 @@ std::vector<AlgorithmRun> run_frames(Session& session, std::string_view name, co
     if (progress) progress(name, f, frames, false);
   }
   for (std::size_t k = 0; k < views; ++k) {
+    runs[split ? 1 + k : 0].choices = v.cullers[k]->choices();  // (a split-screen frame's whole has none)
     runs[split ? 1 + k : 0].longest_miss_frames = misses[k].longest();
     whole.longest_miss_frames = std::max(whole.longest_miss_frames, misses[k].longest());
   }

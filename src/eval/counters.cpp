@@ -41,6 +41,13 @@ constexpr std::array kCounters = std::to_array<Counter>({
      &S::boxes_tested_per_frame, -1, false, "count", "node and object boxes tested against the occlusion buffer (soc)"},
     {"buffer_texels", &F::buffer_texels, none, C::max, C::mean, C::median, "buffer_texels", &S::buffer_texels, -1,
      false, "count", "the occlusion buffer's width × height (soc)"},
+    {"auto_choice", &F::auto_choice, none, C::max, C::none, C::none, "", none, -1, false, "index",
+     "auto: 1 + the index of the candidate it ran (results.json's auto_choices name them in order); 0 for the "
+     "other cullers"},
+    {"auto_tries", &F::auto_tries, none, C::sum, C::sum, C::median, "auto_tries", &S::auto_tries, -1, false, "0/1",
+     "auto: 1 on the first frame of a try of a challenger"},
+    {"auto_switches", &F::auto_switches, none, C::sum, C::sum, C::median, "auto_switches", &S::auto_switches, -1,
+     false, "0/1", "auto: 1 on the first frame of a new culler kept (a challenger that won its try)"},
     {"queries", &F::queries, &B::queries, C::sum, C::mean, C::median, "queries_per_frame", &S::queries_per_frame, -1,
      false, "count", "occlusion queries issued"},
     {"query_boxes", &F::query_boxes, &B::query_boxes, C::sum, C::none, C::none, "", none, -1, false, "count",

@@ -108,6 +108,15 @@ std::string setup_line(const BenchResult& r) {
                      sampling_text(r), r.tiled_world.empty() ? "" : "\n" + r.tiled_world);
 }
 
+// What auto chose: each candidate's share of the frames, its tries and switches.
+std::string auto_line(const BenchResult& r, const AlgorithmSummary& a) {
+  std::string ran;
+  for (const auto& [candidate, share] : a.auto_choices)
+    ran += fmt::format("{}{} {:.0f}%", ran.empty() ? "" : ", ", candidate, 100.0 * share);
+  return fmt::format("{}: ran {} of the frames; {:.0f} tries of a challenger, {:.0f} switches{}", a.name, ran,
+                     a.auto_tries, a.auto_switches, r.repeat > 1 ? " (median of the repeats)" : "");
+}
+
 std::string misses_text(const BenchResult& r, std::uint64_t v) {
   return r.verified ? fmt::format("{}", v) : "-";
 }
@@ -150,6 +159,7 @@ void print_table(const BenchResult& r, std::ostream& out) {
       out << fmt::format("{}: {:.2f} query results per frame not there within the stall guard's time, taken as "
                          "visible\n",
                          a.name, a.stalled_per_frame);
+    if (!a.auto_choices.empty()) out << auto_line(r, a) << "\n";
     if (a.conditional_objects_per_frame > 0)
       out << fmt::format("{}: {:.1f} objects per frame drawn under conditional rendering, {:.1f} of them skipped "
                          "by the device (their query found them hidden)\n",
@@ -271,6 +281,9 @@ nlohmann::ordered_json detail::bench_json(const BenchResult& r) {
     for (const MemorySample& m : a.memory)
       memory.push_back({{"frame", m.frame}, {"rss_mb", m.rss_mb}, {"gpu_mb", m.gpu_mb}});
     algos.back()["memory"] = memory;
+    ordered_json choices;  // null for the cullers other than auto
+    for (const auto& [candidate, share] : a.auto_choices) choices[candidate] = share;
+    algos.back()["auto_choices"] = choices;
   }
   doc["algorithms"] = algos;
   return doc;
@@ -377,6 +390,8 @@ std::vector<std::string> write_report(const BenchResult& r, const std::string& d
   }
   md += "\n";
   for (const std::string& line : verdict_lines(r)) md += "**" + line + "**\n\n";
+  for (const AlgorithmSummary& a : r.summaries)
+    if (!a.auto_choices.empty()) md += auto_line(r, a) + "\n\n";
   md += "Frame times are wall clock, each frame closed by `glFinish`; ratios compare means measured in "
         "the same run. *missed* counts objects visible in the ground truth (object-id buffer of "
         "everything in the frustum) that the algorithm did not render, summed over frames; *wrong px* "

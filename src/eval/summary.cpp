@@ -115,6 +115,12 @@ std::vector<AlgorithmSummary> summarize_runs(std::span<const AlgorithmRun> runs)
         per_repeat["instantiate_ms_per_tile"].push_back(sum_of(sums, "instantiate_ms") / instantiated);
       if (nodes > 0) per_repeat["cpu_us_per_node"].push_back(1e3 * sum_of(sums, "cpu_ms") / nodes);
       if (r.repeat == 0) a.memory = r.memory;
+      for (const FrameStats& f : r.frames)  // frames per candidate, turned into shares below
+        if (f.auto_choice > 0 && f.auto_choice <= r.choices.size()) {
+          if (a.auto_choices.empty())
+            for (const std::string& c : r.choices) a.auto_choices.emplace_back(c, 0.0);
+          a.auto_choices[f.auto_choice - 1].second += 1.0;
+        }
       if (a.first_miss.empty()) a.first_miss = r.first_miss;
       // A view of a split-screen run compares with the same view of the baseline.
       const std::size_t view_at = r.name.find(" [view ");
@@ -143,6 +149,9 @@ std::vector<AlgorithmSummary> summarize_runs(std::span<const AlgorithmRun> runs)
       const auto it = per_repeat.find(key);
       return it == per_repeat.end() ? 0.0 : median_of(it->second);
     };
+    double chosen = 0.0;
+    for (const auto& c : a.auto_choices) chosen += c.second;
+    for (auto& c : a.auto_choices) c.second /= std::max(1.0, chosen);
     a.frame_ms = {med("mean"), med("median"), med("p95"), med("max")};
     a.ratio_to_vfc = med("ratio_to_vfc");
     a.ratio_to_oracle = med("ratio_to_oracle");

@@ -432,7 +432,7 @@ DeviceCulling::Visibility Renderer::create_visibility() {
   const auto n = GLsizeiptr(std::max<std::size_t>(g.object_capacity, 1) * 4);
   GLuint buffer = 0;
   glCreateBuffers(1, &buffer);
-  glNamedBufferStorage(buffer, n, nullptr, 0);
+  glNamedBufferStorage(buffer, n, nullptr, GL_DYNAMIC_STORAGE_BIT);  // set_visible writes it
   glClearNamedBufferData(buffer, GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, nullptr);  // nothing visible yet
   const auto free_slot = std::find(d.visibility.begin(), d.visibility.end(), 0u);
   if (free_slot != d.visibility.end()) {
@@ -448,6 +448,16 @@ void Renderer::destroy_visibility(Visibility v) {
   GLuint buffer = g.visibility_buffer(v, "destroy_visibility");
   glDeleteBuffers(1, &buffer);
   g.device->visibility[v] = 0;
+}
+
+void Renderer::set_visible(Visibility v, std::span<const ObjectId> visible) {
+  Impl& g = *impl_;
+  const BackendTimer timer{stats_.backend_ms};
+  const GLuint buffer = g.visibility_buffer(v, "set_visible");
+  std::vector<GLuint> bits(std::max<std::size_t>(g.object_capacity, 1), 0u);
+  for (ObjectId id : visible)
+    if (id < bits.size()) bits[id] = 1u;
+  glNamedBufferSubData(buffer, 0, GLsizeiptr(bits.size() * sizeof(GLuint)), bits.data());
 }
 
 void Renderer::draw_previously_visible(Visibility v) {

@@ -170,6 +170,7 @@ class Renderer final : public Backend, public DeviceCulling {
   void build_depth_pyramid() override;
   void draw_newly_visible(Visibility v, int texels) override;
   DeviceCullingTimes read_drawn(std::vector<ObjectId>& out) override;
+  void set_visible(Visibility v, std::span<const ObjectId> visible) override;
   /// Whether device draws are compacted (drawn with a count the device
   /// wrote) rather than one command per object. Precondition: a
   /// DeviceCulling call was made.
