@@ -50,7 +50,8 @@ TEST(AutoSchedule, ATryAboveCutTimesTheBestEndsAfterOneFrame) {
 
 TEST(AutoSchedule, KeepsTheCheapestFromFrameOnePlusTrialTimesCandidatesOn) {
   // The documented convergence: with fixed costs, the cheapest runs from
-  // frame 1 + trial x candidates on (until the first retry, period frames later at the earliest).
+  // frame 1 + trial x candidates on, until the first retry of a loser:
+  // period frames after the start's round, which takes 1 + candidates frames at least.
   const detail::AutoConfig c = config();
   std::uint64_t seed = 12345;
   for (int round = 0; round < 50; ++round) {
@@ -62,7 +63,7 @@ TEST(AutoSchedule, KeepsTheCheapestFromFrameOnePlusTrialTimesCandidatesOn) {
     }
     const std::size_t best = std::size_t(std::min_element(cost.begin(), cost.end()) - cost.begin());
     detail::AutoSchedule s(c, n);
-    const auto ran = run(s, cost, 1 + c.trial * int(n) + c.period);
+    const auto ran = run(s, cost, 1 + int(n) + c.period);
     for (std::size_t k = std::size_t(1 + c.trial * int(n)); k < ran.size(); ++k)
       ASSERT_EQ(ran[k], best) << "round " << round << ", frame " << k;
   }

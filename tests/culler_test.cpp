@@ -193,9 +193,10 @@ TEST(MakeCuller, AsksTheContextForNohcsProfileOnlyWhenACullerNeedsIt) {
   EXPECT_EQ(asked, 0);
   (void)make_culler("nohc", {scene, bvh}, {}, context);
   EXPECT_EQ(asked, 1);
-  (void)make_culler("auto", {scene, bvh}, {}, context);  // the default candidates take nohc when a profile is at hand
+  (void)make_culler("auto", {scene, bvh}, {}, context);  // the default candidates leave nohc out
+  EXPECT_EQ(asked, 1);
+  (void)make_culler("auto:candidates=chc+nohc", {scene, bvh}, {}, context);  // ... and take it when named
   EXPECT_EQ(asked, 2);
-  (void)make_culler("auto", {scene, bvh});  // ... and leave it out when none is
 }
 
 TEST(MakeSplitScreen, AlgorithmsThatShareViewsMakeThemTogetherTheOthersOnePerView) {

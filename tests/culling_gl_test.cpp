@@ -21,7 +21,9 @@ constexpr int kFrames = 10;
 const char* const kConservative[] = {
     "stopwait", "chc", "chc:skip=4", "chcpp", "chcpp:batch=1", "chcpp:vqueue=off",
     "chcpp:multiquery=off", "chcpp:jitter=off", "chcpp:tight=off", "chcpp:virtual_leaf=0", "nohc",
-    "auto:trial=1:period=2",  // auto switching every few frames: each candidate returns to stale state
+    // auto switching every few frames: candidates handed the visible set of the one before (chc,
+    // chcpp, nohc, hiz: auto.cpp's hand-over) or back to their own stale state
+    "auto:trial=1:period=2", "auto:candidates=soc+nohc+hiz+chcpp:trial=1:period=1",
     "hiz", "hiz:texels=2", "hiz:texels=16",
     "soc", "soc:scale=1", "soc:width=64:height=36", "soc:width=131:height=47", "soc:simd=off",
     "chc:cpu_test=on", "chcpp:cpu_test=on", "nohc:cpu_test=on"};

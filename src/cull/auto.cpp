@@ -22,13 +22,13 @@
 //   - Back after longer, or never run, a Resumable candidate (chc, chcpp,
 //     nohc, hiz) is handed the visibility of the frame before: the objects
 //     the previous candidate drew (Culler::drawn_objects(), the visible set
-//     every culler shares), when that one culled by occlusion (drew fewer
-//     objects than the frustum holds). chc, chcpp, nohc rebuild their node
-//     states from it as after a rebuilt hierarchy (carry_over); hiz's phase
-//     1 draws it. Conservative whatever the set says: queries or the depth
-//     pyramid test what it calls hidden. After vfc (it drew the whole
-//     frustum) or hiz (its drawn set stays on the device) there is nothing
-//     to hand over, and the candidate resumes from its own state.
+//     every culler shares), when that one culled by occlusion (not vfc).
+//     chc, chcpp, nohc rebuild their node states from it as after a
+//     rebuilt hierarchy (carry_over); hiz's phase 1 draws it. Conservative
+//     whatever the set says: queries or the depth pyramid test what it
+//     calls hidden. After vfc (it drew the whole frustum) or hiz (its drawn
+//     set stays on the device) there is nothing to hand over, and the
+//     candidate resumes from its own state.
 //   - soc and vfc keep no state across frames: nothing to keep warm.
 //   - What a switch still costs is priced in: every frame a candidate runs
 //     is measured, the first one of a try included.
@@ -96,8 +96,8 @@ bool AutoSchedule::hopeless(std::size_t c) const {
 }
 
 void AutoSchedule::lost(std::size_t c, std::uint32_t by) {
-  losses_[c] = std::min<std::uint32_t>(losses_[c] + by, 4);
-  next_try_[c] = frame_ + (std::uint64_t(config_.period) << losses_[c]);
+  losses_[c] = std::min<std::uint32_t>(losses_[c] + by, 5);
+  next_try_[c] = frame_ + (std::uint64_t(config_.period) << (losses_[c] - 1));  // period x 1, 2, 4, 8, 16
 }
 
 void AutoSchedule::end_trial(bool cut) {
@@ -112,7 +112,7 @@ void AutoSchedule::end_trial(bool cut) {
     return;
   }
   if (measured < cost_[current_] * (1.0 - config_.margin)) {
-    next_try_[current_] = frame_ + (std::uint64_t(config_.period) << losses_[current_]);
+    next_try_[current_] = frame_ + std::uint64_t(config_.period);
     cost_[c] = measured;
     current_ = c;
     losses_[c] = 0;
@@ -120,7 +120,7 @@ void AutoSchedule::end_trial(bool cut) {
     switched_ = true;
   } else {
     cost_[c] = measured;
-    lost(c, cut ? 2 : 1);  // lost by far: its next try waits four times as long
+    lost(c, cut ? 3 : 1);  // lost by far: as three lost tries (its next in 4 x period frames at least)
   }
   running_ = current_;
 }
@@ -129,7 +129,7 @@ void AutoSchedule::after_initial(std::size_t c) {
   for (std::size_t n = c + 1; n < count_; ++n) {
     if (disabled_[n]) continue;
     if (hopeless(n)) {
-      lost(n, 2);
+      lost(n, 3);
       continue;
     }
     start_trial(n);
@@ -142,9 +142,9 @@ void AutoSchedule::after_initial(std::size_t c) {
     if (!disabled_[i] && cost_[i] > 0.0 && (current_ == count_ || cost_[i] < cost_[current_])) current_ = i;
   if (current_ == count_)  // nothing measured (every try disabled at once): the first that may run
     current_ = std::size_t(std::find(disabled_.begin(), disabled_.end(), false) - disabled_.begin());
-  // The others lost their try of the round: by far (more than cut x) counts twice, as a try cut short does.
+  // The others lost their try of the round: by far (more than cut x) as three lost tries, as a try cut short.
   for (std::size_t i = 0; i < count_; ++i)
-    if (i != current_ && cost_[i] > 0.0) lost(i, cost_[i] > config_.cut * cost_[current_] ? 2 : 1);
+    if (i != current_ && cost_[i] > 0.0) lost(i, cost_[i] > config_.cut * cost_[current_] ? 3 : 1);
   running_ = current_;
 }
 
@@ -160,7 +160,7 @@ void AutoSchedule::choose_next() {
       start_trial(due);
       return;
     }
-    lost(due, 2);
+    lost(due, 3);
   }
 }
 
@@ -194,27 +194,28 @@ namespace {
 // what they did with the frame rather than on what the frame held.
 constexpr double kTrianglesPerDraw = 64.0;
 
+// Subtrees of at most this many objects count whole when the frustum cuts them.
+constexpr std::uint32_t kWholeSubtree = 8;
+
 // A candidate back after at most this many frames goes on from its own state.
 constexpr std::uint64_t kFreshFrames = 4;
 
 // The content of every subtree, so that a node inside the frustum counts at
 // once: measuring a view costs a frustum traversal down to the nodes its
-// planes cut, not a walk over every object in it.
+// planes cut, not a walk over every object in it. A subtree of at most
+// kWholeSubtree objects that the planes cut counts whole: the measure is a
+// scale for comparing frames, the same whoever culls, and the traversal
+// stops a few levels above the leaves (auto's own CPU time per frame).
 class FrustumContent {
  public:
   explicit FrustumContent(const SceneIndex& index) : index_(index) {}
 
-  struct Measure {
-    double content = 0.0;      ///< triangles + kTrianglesPerDraw x objects
-    std::size_t objects = 0;   ///< objects in the frustum
-  };
-
-  Measure operator()(const View& view) {
+  /// Triangles + kTrianglesPerDraw x objects in the view's frustum (at least 1).
+  double operator()(const View& view) {
     refresh();
-    Measure m;
-    add(Bvh::root(), Frustum::all_planes, view, m);
-    m.content = std::max(1.0, m.content);
-    return m;
+    double content = 0.0;
+    add(Bvh::root(), Frustum::all_planes, view, content);
+    return std::max(1.0, content);
   }
 
  private:
@@ -235,13 +236,12 @@ class FrustumContent {
     }
   }
 
-  void add(NodeId n, std::uint32_t planes, const View& view, Measure& m) const {
+  void add(NodeId n, std::uint32_t planes, const View& view, double& content) const {
     const Bvh& bvh = index_.bvh;
     if (bvh.node(n).object_count == 0) return;
     if (planes != 0 && view.frustum.classify(bvh.node(n).bounds, planes) == Containment::outside) return;
-    if (planes == 0) {  // inside: the whole subtree
-      m.content += subtree_[n];
-      m.objects += bvh.node(n).object_count;
+    if (planes == 0 || bvh.node(n).object_count <= kWholeSubtree) {  // inside, or small: the whole subtree
+      content += subtree_[n];
       return;
     }
     if (bvh.is_leaf(n)) {
@@ -249,13 +249,12 @@ class FrustumContent {
         const Object& o = index_.scene.object(id);
         std::uint32_t mask = planes;
         if (o.bounds.empty() || view.frustum.classify(o.bounds, mask) == Containment::outside) continue;
-        m.content += of(o);
-        ++m.objects;
+        content += of(o);
       }
       return;
     }
-    add(Bvh::left(n), planes, view, m);
-    add(bvh.right(n), planes, view, m);
+    add(Bvh::left(n), planes, view, content);
+    add(bvh.right(n), planes, view, content);
   }
 
   SceneIndex index_;
@@ -281,10 +280,9 @@ class AutoCuller final : public Culler {
   FrameStats cull(const View& view, Backend& backend) override {
     if (!started_) start(backend);
     if (awaiting_feedback_) finished(FrameStats{});  // the owner did not call frame_finished
-    const FrustumContent::Measure frustum = content_of_(view);
-    content_ = frustum.content;
+    content_ = content_of_(view);
     const std::size_t run = schedule_.next();
-    if (run != last_ && last_ < candidates_.size()) hand_over(last_, run, frustum.objects);
+    if (run != last_ && last_ < candidates_.size()) hand_over(last_, run);
     candidates_[run].last_frame = ++frame_;
     const bool tried = schedule_.starts_try(), switched = schedule_.just_switched();
     const auto t0 = std::chrono::steady_clock::now();
@@ -350,13 +348,14 @@ class AutoCuller final : public Culler {
   // `to` runs after `from` ran last frame: hands it the visibility `from`
   // found, when `to` has been away long or never ran, `from` culled by
   // occlusion and `to` can take it (the policy at the top of this file).
-  void hand_over(std::size_t from, std::size_t to, std::size_t in_frustum) {
+  void hand_over(std::size_t from, std::size_t to) {
+    if (candidates_[from].frustum) return;  // vfc drew the frustum: no news
     const std::uint64_t last = candidates_[to].last_frame;
     if (last != 0 && frame_ - last <= kFreshFrames) return;  // its own state is fresher
     auto* resumable = dynamic_cast<Resumable*>(candidates_[to].culler.get());
     if (!resumable) return;
     const std::span<const ObjectId> drawn = candidates_[from].culler->drawn_objects();
-    if (drawn.empty() || drawn.size() >= in_frustum) return;
+    if (drawn.empty()) return;  // hiz: its drawn set is on the device
     resumable->resume_from(drawn);
   }
 
@@ -378,11 +377,13 @@ Registration auto_registration() {
   static const ConfigTable<C> table =
       ConfigTable<C>()
           .text("candidates", &C::candidates,
-                "cullers to choose among, joined by +, tried in this order (by default every conservative one: nohc "
-                "only where a profile is at hand, as occull bench has; hiz only on a backend with device culling)")
+                "cullers to choose among, joined by +, tried in this order (by default those that were cheapest "
+                "somewhere in the default suite; hiz only on a backend with device culling; add nohc with a "
+                "hardware profile)")
           .integer("trial", &C::trial, 1, 1000, "frames a try of a candidate runs at most (its cost: their mean)")
           .integer("period", &C::period, 1, 1000000,
-                   "frames between tries of a challenger (doubled after each lost try, up to 16x)")
+                   "frames before a loser's next try (doubled after each further loss, up to 16x; a loss by more "
+                   "than cut counts as three)")
           .real("margin", &C::margin, 0.0, 0.9,
                 "a challenger must be this much cheaper to take over (frame times of one culler vary by a few "
                 "percent between frames)")
@@ -400,9 +401,6 @@ Registration auto_registration() {
           names.emplace_back(rest.substr(0, plus));
           rest = plus == std::string_view::npos ? std::string_view{} : rest.substr(plus + 1);
         }
-        // nohc needs a calibrated profile; without one the default candidates leave it out.
-        if (!o.has("auto.candidates") && !o.has("nohc.profile") && !has_nohc_profile(context))
-          std::erase(names, "nohc");
         if (names.empty()) throw InputError("option auto.candidates: no candidate given (e.g. chcpp+vfc+nohc)");
         std::vector<Candidate> candidates;
         for (const std::string& name : names) {

@@ -11,12 +11,13 @@ namespace occull::detail {
 struct AutoConfig {
   /// Candidates, joined by +, tried in this order at the start (chc first:
   /// from nothing it settles in one frame, CHC++ in several, and the next
-  /// ones start from its visible set). By default
-  /// every conservative culler that may run: nohc only where a profile is
-  /// at hand, hiz only on a backend with device culling (auto.cpp).
-  std::string candidates = "chc+chcpp+nohc+soc+hiz+vfc";
+  /// ones start from its visible set). By default every conservative culler
+  /// that was the cheapest on some entry of `occull bench --suite default`;
+  /// hiz only on a backend with device culling (auto.cpp). Not nohc: never
+  /// the cheapest there, and its first frame costs 2-3x its later ones.
+  std::string candidates = "chc+chcpp+soc+hiz+vfc";
   int trial = 2;           ///< frames a try runs at most (its cost: their mean)
-  int period = 40;         ///< frames before a challenger's next try; doubled after each lost try, up to 16x
+  int period = 40;         ///< frames before a loser's next try; doubled after each further loss, up to 16x
   double margin = 0.08;    ///< a challenger must be this much cheaper than the current to take over (hysteresis)
   double cut = 1.3;        ///< a try whose first frame costs more than this times the current's cost ends there
   double skip = 1.5;       ///< a challenger estimated above this times the current's cost is not tried (a lost try)
@@ -40,10 +41,12 @@ struct AutoConfig {
 /// is predictable: it draws the frustum) exceeds `skip` x the current's.
 /// The challenger takes over when its try's mean is below (1 - margin) x
 /// the current's running cost; two candidates of equal cost therefore do
-/// not alternate. A challenger that loses waits twice as long for its next
-/// try (period, 2, 4, ... 16 x period frames; one cut after its first frame
-/// or skipped as hopeless, four times as long): after the costs change, the
-/// cheaper candidate is kept within trial + 16 x period frames.
+/// not alternate. A challenger that loses waits period frames for its next
+/// try, twice as long after each further loss, up to 16 x period; a try cut
+/// after its first frame, one that lost the start's round by more than
+/// `cut`, or one skipped as hopeless counts as three losses (4 x period at
+/// least). So after the costs change, the cheaper candidate is kept within
+/// trial + 16 x period frames.
 class AutoSchedule {
  public:
   AutoSchedule(AutoConfig config, std::size_t candidates);

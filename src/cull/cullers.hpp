@@ -42,7 +42,5 @@ class Resumable {
 /// `context.nohc_profile_source()`. Throws
 /// InputError when there is none, or the file does not exist.
 HardwareProfile nohc_profile(const CullerContext& context, const std::string& file);
-/// Whether nohc_profile() would find a profile without a file.
-bool has_nohc_profile(const CullerContext& context);
 
 }  // namespace occull::detail

@@ -386,10 +386,6 @@ HardwareProfile nohc_profile(const CullerContext& context, const std::string& fi
                    "--opt nohc.profile=FILE (CullerContext::nohc_profile in a program)");
 }
 
-bool has_nohc_profile(const CullerContext& context) {
-  return context.nohc_profile != nullptr || bool(context.nohc_profile_source);
-}
-
 Registration nohc_registration() {
   using C = NohcConfig;
   static const ConfigTable<C> table =
