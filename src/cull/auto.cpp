@@ -197,24 +197,29 @@ constexpr double kTrianglesPerDraw = 64.0;
 // Subtrees of at most this many objects count whole when the frustum cuts them.
 constexpr std::uint32_t kWholeSubtree = 8;
 
+// The frustum's exact content is measured every this many frames.
+constexpr std::uint64_t kExactEvery = 8;
+
 // A candidate back after at most this many frames goes on from its own state.
 constexpr std::uint64_t kFreshFrames = 4;
 
 // The content of every subtree, so that a node inside the frustum counts at
 // once: measuring a view costs a frustum traversal down to the nodes its
-// planes cut, not a walk over every object in it. A subtree of at most
-// kWholeSubtree objects that the planes cut counts whole: the measure is a
-// scale for comparing frames, the same whoever culls, and the traversal
-// stops a few levels above the leaves (auto's own CPU time per frame).
+// planes cut, not a walk over every object in it. Roughly (`exact` false),
+// a subtree of at most kWholeSubtree objects that the planes cut counts
+// whole: a scale for comparing frames, the same whoever culls, whose
+// traversal stops a few levels above the leaves (auto's own CPU time per
+// frame); exactly, the objects of the leaves the planes cut are tested.
 class FrustumContent {
  public:
   explicit FrustumContent(const SceneIndex& index) : index_(index) {}
 
-  /// Triangles + kTrianglesPerDraw x objects in the view's frustum (at least 1).
-  double operator()(const View& view) {
+  /// Triangles + kTrianglesPerDraw x objects in the view's frustum (at
+  /// least 1), roughly or exactly.
+  double operator()(const View& view, bool exact) {
     refresh();
     double content = 0.0;
-    add(Bvh::root(), Frustum::all_planes, view, content);
+    add(Bvh::root(), Frustum::all_planes, view, exact ? 0 : kWholeSubtree, content);
     return std::max(1.0, content);
   }
 
@@ -236,11 +241,11 @@ class FrustumContent {
     }
   }
 
-  void add(NodeId n, std::uint32_t planes, const View& view, double& content) const {
+  void add(NodeId n, std::uint32_t planes, const View& view, std::uint32_t whole, double& content) const {
     const Bvh& bvh = index_.bvh;
     if (bvh.node(n).object_count == 0) return;
     if (planes != 0 && view.frustum.classify(bvh.node(n).bounds, planes) == Containment::outside) return;
-    if (planes == 0 || bvh.node(n).object_count <= kWholeSubtree) {  // inside, or small: the whole subtree
+    if (planes == 0 || bvh.node(n).object_count <= whole) {  // inside, or small: the whole subtree
       content += subtree_[n];
       return;
     }
@@ -253,8 +258,8 @@ class FrustumContent {
       }
       return;
     }
-    add(Bvh::left(n), planes, view, content);
-    add(bvh.right(n), planes, view, content);
+    add(Bvh::left(n), planes, view, whole, content);
+    add(bvh.right(n), planes, view, whole, content);
   }
 
   SceneIndex index_;
@@ -280,7 +285,10 @@ class AutoCuller final : public Culler {
   FrameStats cull(const View& view, Backend& backend) override {
     if (!started_) start(backend);
     if (awaiting_feedback_) finished(FrameStats{});  // the owner did not call frame_finished
-    content_ = content_of_(view);
+    content_ = content_of_(view, false);
+    // vfc's estimate needs the frustum's exact content; it is measured now
+    // and then (the estimate only spares tries), its share of the rough one kept.
+    if (frame_ % kExactEvery == 0) exact_share_ = content_of_(view, true) / content_;
     const std::size_t run = schedule_.next();
     if (run != last_ && last_ < candidates_.size()) hand_over(last_, run);
     candidates_[run].last_frame = ++frame_;
@@ -297,6 +305,7 @@ class AutoCuller final : public Culler {
   }
 
   void frame_finished(const FrameStats& measured) override {
+    if (last_ >= candidates_.size()) return;  // no frame rendered yet
     candidates_[last_].culler->frame_finished(measured);
     if (awaiting_feedback_) finished(measured);
   }
@@ -337,10 +346,11 @@ class AutoCuller final : public Culler {
   void finished(const FrameStats& measured) {
     awaiting_feedback_ = false;
     const double drawn = double(measured.triangles) + kTrianglesPerDraw * double(measured.draw_calls);
-    if (measured.frame_ms > 0.0 && drawn > 0.0 && !candidates_[last_].frustum) {
+    // (Not from hiz's frames: what the device drew is read back after the frame, if at all.)
+    if (measured.frame_ms > 0.0 && drawn > 0.0 && !candidates_[last_].frustum && !candidates_[last_].device) {
       const double per_unit = std::max(0.0, measured.frame_ms - measured.cpu_ms - measured.wait_ms) / drawn;
       for (std::size_t c = 0; c < candidates_.size(); ++c)
-        if (candidates_[c].frustum) schedule_.estimate(c, per_unit);
+        if (candidates_[c].frustum) schedule_.estimate(c, per_unit * exact_share_);
     }
     schedule_.finished((measured.frame_ms > 0.0 ? measured.frame_ms : own_ms_) / content_);
   }
@@ -360,7 +370,8 @@ class AutoCuller final : public Culler {
   }
 
   FrustumContent content_of_;
-  double content_ = 1.0;
+  double content_ = 1.0;      // this frame's, roughly
+  double exact_share_ = 1.0;  // exact content / rough content, when last measured
   std::vector<Candidate> candidates_;
   AutoSchedule schedule_;
   std::size_t last_ = std::size_t(-1);  // the candidate run in the last frame
