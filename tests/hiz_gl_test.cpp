@@ -2,6 +2,7 @@
 // frames. Every scene kind through the verifier is in culling_gl_test.cpp
 // and adversarial_test.cpp (hiz is among their conservative cullers).
 #include "gl/gl.hpp"
+#include "cull/cullers.hpp"
 #include "occull/culler.hpp"
 #include "occull/depth_pyramid.hpp"
 #include "occull/error.hpp"
@@ -216,6 +217,26 @@ TEST_F(Hiz, AnEmptySceneAndObjectsWithoutTrianglesDrawNothing) {
   for (int f = 0; f < 2; ++f)
     EXPECT_EQ(frame(*hiz2, r2, w.scene, w.view), (std::vector<ObjectId>{WallScene::wall, WallScene::beside}));
   hiz2->release(r2);
+}
+
+TEST_F(Hiz, AVisibleSetHandedOverIsDrawnInPhaseOne) {
+  // auto's hand-over (detail::Resumable, DeviceCulling::set_visible): the set
+  // handed over is the device's visibility for the next phase 1.
+  WallScene w;
+  gl::Renderer r(w.scene, target());
+  auto fresh = make_culler("hiz", {w.scene, w.bvh});
+  EXPECT_EQ(frame(*fresh, r, w.scene, w.view),
+            (std::vector<ObjectId>{WallScene::wall, WallScene::hidden, WallScene::beside}))
+      << "from nothing, phase 2 tests against an empty pyramid";
+  fresh->release(r);
+  auto hiz = make_culler("hiz", {w.scene, w.bvh});
+  auto* resumable = dynamic_cast<detail::Resumable*>(hiz.get());
+  ASSERT_NE(resumable, nullptr);
+  const std::vector<ObjectId> handed{WallScene::wall};
+  resumable->resume_from(handed);
+  EXPECT_EQ(frame(*hiz, r, w.scene, w.view), (std::vector<ObjectId>{WallScene::wall, WallScene::beside}))
+      << "phase 1 drew the wall handed over, so the box behind it is culled in the first frame";
+  hiz->release(r);
 }
 
 TEST_F(Hiz, AVisibilityHandedBackCannotBeUsedAgain) {
