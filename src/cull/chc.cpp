@@ -39,8 +39,7 @@ class ChcCuller final : public CpuTestedCuller {
   FrameStats cull_frame(const View& view, Backend& backend) override {
     ++frame_;
     seen_.begin(index_.scene);
-    const bool rebuilt = seen_.rebuilt(index_.bvh);
-    if (take_hand_over(seen_, frame_ - 1) || rebuilt) carry_over(state_, index_.bvh, seen_, frame_ - 1);
+    if (states_restart(seen_, index_.bvh, frame_ - 1)) carry_over(state_, index_.bvh, seen_, frame_ - 1);
     f_.begin(view, backend);
 
     queue_.push(index_.bvh, Bvh::root(), view.eye);

@@ -118,8 +118,7 @@ class ChcppCuller final : public CpuTestedCuller {
   FrameStats cull_frame(const View& view, Backend& backend) override {
     ++frame_;
     seen_.begin(index_.scene);
-    const bool rebuilt = seen_.rebuilt(index_.bvh);
-    if (take_hand_over(seen_, frame_ - 1) || rebuilt) {
+    if (states_restart(seen_, index_.bvh, frame_ - 1)) {
       carry_over(state_, index_.bvh, seen_, frame_ - 1);
       // A leaf carried over visible was drawn last frame: its next query
       // comes as a newly visible leaf's would, not all at once now.

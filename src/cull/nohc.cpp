@@ -110,7 +110,7 @@ class NohcCuller final : public CpuTestedCuller {
     // conservative whatever it says: only queries cull); a changed set of
     // objects changes the nodes' areas and shading.
     seen_.begin(index_.scene);
-    const bool rebuilt = seen_.rebuilt(index_.bvh) | take_hand_over(seen_, frame_ - 1);
+    const bool rebuilt = states_restart(seen_, index_.bvh, frame_ - 1);
     if (rebuilt || layout_ != index_.scene.layout_revision()) describe_nodes(rebuilt);
     f_.begin(view, backend);
     frustum_.begin(index_.bvh, view);

@@ -294,11 +294,13 @@ class CpuTestedCuller : public Culler, public Resumable {
   }
 
  protected:
-  /// At the start of a frame (after `seen.begin`): records a hand-over as
-  /// drawn in `last_frame` and says whether there was one (the caller then
-  /// rebuilds its states with carry_over, as after a rebuilt hierarchy).
-  bool take_hand_over(ObjectVisibility& seen, std::uint32_t last_frame) {
-    if (!resume_) return false;
+  /// At the start of a frame (after `seen.begin`): whether the node states
+  /// must be rebuilt from `seen` with carry_over — the hierarchy was
+  /// rebuilt, or a hand-over came (recorded in `seen` as drawn in
+  /// `last_frame`).
+  bool states_restart(ObjectVisibility& seen, const Bvh& bvh, std::uint32_t last_frame) {
+    const bool rebuilt = seen.rebuilt(bvh);
+    if (!resume_) return rebuilt;
     resume_ = false;
     seen.replace(handed_over_, last_frame);
     return true;
