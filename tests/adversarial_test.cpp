@@ -92,11 +92,6 @@ std::uint64_t misses(const std::string& scene, const std::string& path, const st
   return missed;
 }
 
-bool on_llvmpipe() {
-  auto context = gl::Context::create();
-  return context->info().renderer.find("llvmpipe") != std::string::npos;
-}
-
 }  // namespace
 
 // Not vacuous: the same scenes make exact query boxes miss one-pixel objects
@@ -104,7 +99,7 @@ bool on_llvmpipe() {
 // and the default query geometry catches them. stopwait waits for every
 // answer, so the outcome depends only on the rasteriser: llvmpipe's.
 TEST(QueryGeometry, ExactQueryBoxesMissOnePixelObjectsThatTheDefaultGeometryCatches) {
-  if (!on_llvmpipe()) GTEST_SKIP() << "pins llvmpipe's rasterisation";
+  if (!test::on_llvmpipe()) GTEST_SKIP() << "pins llvmpipe's rasterisation";
   const std::string scene = "adversarial:kind=far";
   EXPECT_GT(misses(scene, "far", "stopwait", gl::QueryRaster::exact, 0.0f), 0u);
   EXPECT_EQ(misses(scene, "far", "stopwait", gl::QueryRaster::margin, gl::RendererOptions{}.query_margin_px), 0u);
@@ -114,6 +109,6 @@ TEST(QueryGeometry, ExactQueryBoxesMissOnePixelObjectsThatTheDefaultGeometryCatc
 // query box face, coplanar with the ground, must pass there too. A sideways
 // margin alone (1/64 px) did not make it; the depth slope term does.
 TEST(QueryGeometry, CoplanarDecalIsSeenByItsQuery) {
-  if (!on_llvmpipe()) GTEST_SKIP() << "pins llvmpipe's rasterisation";
+  if (!test::on_llvmpipe()) GTEST_SKIP() << "pins llvmpipe's rasterisation";
   EXPECT_EQ(misses("adversarial:kind=thin", "far", "stopwait", gl::QueryRaster::margin, 1.0f / 64.0f), 0u);
 }

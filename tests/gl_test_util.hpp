@@ -1,6 +1,7 @@
 // Test helper for GL tests: a small, fast render target.
 #pragma once
 
+#include "occull/gl/context.hpp"
 #include "occull/gl/renderer.hpp"
 
 #include <cstdint>
@@ -17,6 +18,13 @@ inline gl::RendererOptions small_target(int width, int height) {
   o.height = height;
   o.write_ids = false;
   return o;
+}
+
+/// Whether the GL driver is Mesa's llvmpipe: tests that pin its
+/// rasterisation (a pixel it covers, a depth it gets wrong) run only there.
+inline bool on_llvmpipe() {
+  auto context = gl::Context::create();
+  return context->info().renderer.find("llvmpipe") != std::string::npos;
 }
 
 /// The objects an id image (gl::Renderer::read_ids) shows.

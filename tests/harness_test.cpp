@@ -128,6 +128,60 @@ TEST(CheckFrame, CountsMissedWrongPixelsAndExtraObjects) {
   EXPECT_EQ(s.extra_objects, 2u);  // 2 and 6; duplicates count once
 }
 
+TEST(CheckFrame, AnObjectSeenOnlyThroughDepthErrorsLeftOutIsNotMissed) {
+  const std::vector<gl::Renderer::ObjectPixels> truth{{1, 100}, {4, 7}, {5, 30}};
+  const std::vector<ObjectId> rendered{1};
+  const std::vector<ObjectId> depth_error_only{4};
+  FrameStats s;
+  EXPECT_EQ(check_frame(truth, rendered, 8, s, depth_error_only), std::vector<ObjectId>{5});
+  EXPECT_EQ(s.missed_objects, 1u);
+  EXPECT_EQ(s.wrong_pixels, 30u);
+  EXPECT_EQ(s.depth_error_objects, 1u);
+  // Drawn, it is simply drawn.
+  EXPECT_TRUE(check_frame(truth, std::vector<ObjectId>{1, 4, 5}, 8, s, depth_error_only).empty());
+  EXPECT_EQ(s.depth_error_objects, 0u);
+}
+
+namespace {
+
+// An 8 x 8 image filled by object 0, a 2 m cube 9 to 11 m ahead of the eye,
+// every pixel at the depth of a point `distance` metres ahead.
+struct DepthErrorImage {
+  Scene scene = test::box_scene({{{-1, -1, -11}, {1, 1, -9}}});
+  View view;
+  std::vector<std::uint32_t> ids = std::vector<std::uint32_t>(64, 1);
+  std::vector<float> depth;
+  DepthErrorImage(DepthMode mode, float distance) {
+    view = make_view({{0, 0, 0}, 0, 0}, {10.0f, 0.1f, 100.0f, mode}, 8, 8);  // every pixel's ray hits the cube
+    const glm::vec4 c = view.view_proj * glm::vec4(0, 0, -distance, 1);
+    const float stored = view.clip.depth == DepthRange::zero_to_one ? c.z / c.w : 0.5f * c.z / c.w + 0.5f;
+    depth.assign(64, view.clip.reversed_z ? 1.0f - stored : stored);
+  }
+  std::vector<ObjectId> only() const { return seen_only_through_depth_errors(scene, view, ids, depth, 8, 8); }
+};
+
+}  // namespace
+
+TEST(DepthErrors, PixelsNearerThanTheirBoxAreTheRasterisersOnly) {
+  for (DepthMode mode : {DepthMode::standard, DepthMode::reversed}) {
+    EXPECT_EQ(DepthErrorImage(mode, 5.0f).only(), std::vector<ObjectId>{0}) << int(mode);
+    EXPECT_TRUE(DepthErrorImage(mode, 9.0f).only().empty()) << int(mode);   // its front face
+    EXPECT_TRUE(DepthErrorImage(mode, 10.5f).only().empty()) << int(mode);  // inside
+    EXPECT_TRUE(DepthErrorImage(mode, 20.0f).only().empty()) << int(mode);  // beyond: no surface, but not nearer
+    // Within the tolerance (0.5 % nearer than its face): its own.
+    EXPECT_TRUE(DepthErrorImage(mode, 8.955f).only().empty()) << int(mode);
+    // One pixel of its own surface is enough.
+    DepthErrorImage one(mode, 5.0f);
+    one.depth[27] = DepthErrorImage(mode, 9.5f).depth[27];
+    EXPECT_TRUE(one.only().empty()) << int(mode);
+    // The background and ids past the scene are nobody's.
+    DepthErrorImage none(mode, 5.0f);
+    std::fill(none.ids.begin(), none.ids.end(), 0u);
+    none.ids[3] = 7;
+    EXPECT_TRUE(none.only().empty()) << int(mode);
+  }
+}
+
 TEST(SummarizeRuns, MediansOverRepeatsAndRatiosWithinARepeat) {
   const auto run = [](const char* name, int rep, std::vector<double> ms, std::uint32_t missed) {
     AlgorithmRun r{name, rep, true, {}, 0};

@@ -622,3 +622,33 @@ TEST_F(RendererTest, ATargetOfZeroOrMoreThanTheLimitIsAnErrorNamingIt) {
     }
   }
 }
+
+// The depth error seen_only_through_depth_errors is for, on the field's
+// glide at 30 fps, frame 30, 320x180: llvmpipe draws terrain tile 138 (528 m
+// away, a sliver of triangles seen edge-on) into 5 pixels, one of them at
+// the depth of 206 m, far in front of the tile's box. That pixel alone is
+// the tile seen only through a depth error; its 4 others are its surface.
+TEST(RendererDepthErrors, LlvmpipePutsOnePixelOfAFarSliverInFrontOfItsBox) {
+  if (!test::on_llvmpipe()) GTEST_SKIP() << "pins llvmpipe's rasterisation";
+  Session session("field", test::small_target(320, 180));
+  session.set_sampling({30.0, 0.0});
+  const View view = session.view_at(session.path("glide"), 30, 31);
+  const std::vector<ObjectId> tile{138};
+  gl::Renderer::PassImages image;
+  ASSERT_EQ(session.renderer().visible_pixels(view, tile, &image).at(0).pixels, 5u);
+  const std::size_t error_pixel = 105 * 320 + 159;
+  ASSERT_EQ(image.ids[error_pixel], 139u);
+  std::vector<std::uint32_t> only_error(image.ids.size(), 0), without_error = image.ids;
+  only_error[error_pixel] = 139;
+  without_error[error_pixel] = 0;
+  const Scene& scene = session.scene();
+  EXPECT_EQ(seen_only_through_depth_errors(scene, view, only_error, image.depth, 320, 180), tile);
+  EXPECT_TRUE(seen_only_through_depth_errors(scene, view, without_error, image.depth, 320, 180).empty());
+  EXPECT_TRUE(seen_only_through_depth_errors(scene, view, image.ids, image.depth, 320, 180).empty());
+  // How far in front: the pixel's depth is that of a point nearer than half the box's distance.
+  const glm::dmat4 to_world = glm::inverse(glm::dmat4(view.view_proj));
+  const glm::dvec4 p = to_world * glm::dvec4((159.5 / 320.0) * 2.0 - 1.0, (105.5 / 180.0) * 2.0 - 1.0,
+                                             2.0 * double(image.depth[error_pixel]) - 1.0, 1.0);
+  const double to_pixel = glm::distance(glm::dvec3(p) / p.w, glm::dvec3(view.eye));
+  EXPECT_LT(to_pixel, 0.5 * double(distance(view.eye, scene.object(138).bounds)));  // 206 m against 528 m
+}

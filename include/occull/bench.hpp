@@ -107,6 +107,9 @@ struct AlgorithmSummary {
   std::uint64_t worst_frame_wrong_pixels = 0;
   std::uint32_t longest_miss_frames = 0;
   std::uint64_t truth_object_frames = 0;  ///< sum over frames of the objects visible in the truth
+  /// Sum over frames of objects left undrawn that only the rasteriser's
+  /// depth errors showed (FrameStats::depth_error_objects; not missed).
+  std::uint64_t depth_error_objects = 0;
   // Tiled worlds (FrameStats' tile counters): per frame, and in all.
   double tiles_rendered_per_frame = 0.0;
   double tile_queries_per_frame = 0.0;

@@ -57,7 +57,36 @@ struct FrameTruth {
   std::vector<gl::Renderer::ObjectPixels> visible;  ///< objects with a visible pixel, sorted by id
   Coverage coverage;                                ///< of the truth pass's depth image
   std::uint32_t probes = 0;  ///< triangles the CPU probe (truth-probe) checked in this frame
+  /// The objects of `visible` that the image shows only through the
+  /// rasteriser's depth errors (seen_only_through_depth_errors), ascending:
+  /// leaving one out is not a miss. Usually empty.
+  std::vector<ObjectId> depth_error_only;
 };
+
+/// The share of the distance from the eye by which a pixel's depth may lie
+/// nearer than where the pixel's ray enters its object's box and still be
+/// taken as the object's own surface (seen_only_through_depth_errors).
+inline constexpr double kDepthErrorTolerance = 0.01;
+
+/// The objects of an id image (row-major, bottom row first; 0 background,
+/// else id + 1) every one of whose pixels lies, by the depth image beside
+/// it (canonical window depth, read_depth()), nearer to the eye than where
+/// the pixel centre's ray enters the object's box — by more than
+/// kDepthErrorTolerance of that distance, with the depth read at its
+/// farthest within float precision and the box grown by its coordinates'
+/// float precision. No surface of the object lies there: the rasteriser
+/// put it there. Mesa's llvmpipe does, in its early depth test, for
+/// sub-pixel sliver triangles (a terrain seen edge-on far away): it
+/// extrapolates their depth far outside their vertices' range, so a tile
+/// 528 m away shows one pixel at 206 m, through a rock at 417 m
+/// (docs/instrument.md, "Depth errors of the rasteriser"). A pixel whose
+/// ray misses the box (snapping widened the outline) or starts inside it
+/// counts as the object's own. Ascending ids. Preconditions: ids and depth
+/// hold width * height values, `view` is the one they were drawn with.
+[[nodiscard]] std::vector<ObjectId> seen_only_through_depth_errors(const Scene& scene, const View& view,
+                                                                   std::span<const std::uint32_t> ids,
+                                                                   std::span<const float> depth, int width,
+                                                                   int height);
 
 /// Called as work progresses: a label (algorithm name, or "ground truth"),
 /// the step just done (0-based), the number of steps, and whether it was a
@@ -66,12 +95,15 @@ struct FrameTruth {
 using ProgressFn = std::function<void(std::string_view label, int step, int steps, bool warmup)>;
 
 /// Verification of one frame: fills truth_objects, missed_objects,
-/// wrong_pixels and extra_objects of `stats` from the frame's truth and the
-/// objects the algorithm rendered (duplicates allowed), and returns the
-/// missed ids (ascending). `object_count` is the scene's object count.
+/// wrong_pixels, extra_objects and depth_error_objects of `stats` from the
+/// frame's truth and the objects the algorithm rendered (duplicates
+/// allowed), and returns the missed ids (ascending). `object_count` is the
+/// scene's object count. An object of `depth_error_only` (ascending; the
+/// truth's FrameTruth::depth_error_only) left out is not missed: it counts
+/// in depth_error_objects.
 std::vector<ObjectId> check_frame(std::span<const gl::Renderer::ObjectPixels> truth,
                                   std::span<const ObjectId> rendered, std::size_t object_count,
-                                  FrameStats& stats);
+                                  FrameStats& stats, std::span<const ObjectId> depth_error_only = {});
 
 /// The process's memory after a frame of a run (every kMemorySampleFrames).
 struct MemorySample {

@@ -80,6 +80,10 @@ struct FrameStats {
   std::uint32_t missed_objects = 0;  ///< in the truth, not rendered: a visible object culled
   std::uint64_t wrong_pixels = 0;    ///< pixels the missed objects own in the truth image
   std::uint32_t extra_objects = 0;   ///< rendered, not in the truth: culling inefficiency
+  /// In the truth and not rendered, but visible only through the
+  /// rasteriser's depth errors (fragments nearer than the object's own box):
+  /// not missed (Session::verify_frame).
+  std::uint32_t depth_error_objects = 0;
 };
 
 }  // namespace occull

@@ -79,6 +79,10 @@ constexpr std::array kCounters = std::to_array<Counter>({
      false, "count", "objects in the ground truth the culler did not draw: a visible object culled"},
     {"wrong_pixels", &F::wrong_pixels, none, C::sum, C::sum, C::max, "wrong_pixels", &S::wrong_pixels, -1, false,
      "count", "pixels the missed objects own in the ground truth"},
+    {"depth_error_objects", &F::depth_error_objects, none, C::sum, C::sum, C::max, "depth_error_objects",
+     &S::depth_error_objects, -1, false, "count",
+     "objects of the ground truth not drawn that only the rasteriser's depth errors show (fragments nearer than "
+     "their own box): not missed"},
     {"extra_objects", &F::extra_objects, none, C::sum, C::mean, C::median, "extra_objects_per_frame",
      &S::extra_objects_per_frame, -1, false, "count", "objects drawn that the ground truth does not show (over-drawing)"},
     {"blocking_waits", &F::blocking_waits, &B::blocking_waits, C::sum, C::mean, C::median, "blocking_waits_per_frame",

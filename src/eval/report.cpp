@@ -82,6 +82,13 @@ std::vector<std::string> verdict_lines(const BenchResult& r) {
   }
   if (!popping.empty())
     lines.push_back("not conservative (may pop by design; misses are popping, not failures): " + popping);
+  std::string depth_errors;
+  for (const AlgorithmSummary& a : r.summaries)
+    if (a.depth_error_objects > 0)
+      depth_errors += fmt::format("{}{} {}", depth_errors.empty() ? "" : ", ", a.name, a.depth_error_objects);
+  if (!depth_errors.empty())
+    lines.push_back("left out, not missed: objects the rasteriser showed only through depth errors (fragments nearer "
+                    "than their own box; docs/instrument.md): " + depth_errors);
   return lines;
 }
 

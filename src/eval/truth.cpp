@@ -9,22 +9,27 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cmath>
+#include <limits>
 
 namespace occull {
 
 std::vector<ObjectId> check_frame(std::span<const gl::Renderer::ObjectPixels> truth,
                                   std::span<const ObjectId> rendered, std::size_t object_count,
-                                  FrameStats& stats) {
+                                  FrameStats& stats, std::span<const ObjectId> depth_error_only) {
   std::vector<std::uint8_t> drawn(object_count, 0);
   for (ObjectId id : rendered) drawn[id] = 1;
   std::vector<ObjectId> missed;
   stats.truth_objects = std::uint32_t(truth.size());
   stats.missed_objects = 0;
   stats.wrong_pixels = 0;
+  stats.depth_error_objects = 0;
   std::size_t rendered_and_visible = 0;
   for (const auto& t : truth) {
     if (drawn[t.id]) {
       ++rendered_and_visible;
+    } else if (std::binary_search(depth_error_only.begin(), depth_error_only.end(), t.id)) {
+      ++stats.depth_error_objects;
     } else {
       missed.push_back(t.id);
       stats.wrong_pixels += t.pixels;
@@ -34,6 +39,61 @@ std::vector<ObjectId> check_frame(std::span<const gl::Renderer::ObjectPixels> tr
   const auto distinct = std::size_t(std::count(drawn.begin(), drawn.end(), std::uint8_t(1)));
   stats.extra_objects = std::uint32_t(distinct - rendered_and_visible);
   return missed;
+}
+
+std::vector<ObjectId> seen_only_through_depth_errors(const Scene& scene, const View& view,
+                                                     std::span<const std::uint32_t> ids, std::span<const float> depth,
+                                                     int width, int height) {
+  const std::size_t n = scene.objects().size();
+  std::vector<std::uint8_t> seen(n, 0), own_surface(n, 0);
+  const glm::dmat4 to_world = glm::inverse(glm::dmat4(view.view_proj));
+  const auto unproject = [&](double x, double y, double z) {
+    const glm::dvec4 p = to_world * glm::dvec4(x, y, z, 1.0);
+    return glm::dvec3(p) / p.w;
+  };
+  // A depth value is read at its farthest within a few float units in the
+  // last place (read_depth's 1 - d under reversed-Z rounds near 1).
+  const double reading = std::ldexp(1.0, -21);
+  const auto magnitude = [](const glm::vec3& v) { return std::max({std::abs(v.x), std::abs(v.y), std::abs(v.z)}); };
+  for (int y = 0; y < height; ++y)
+    for (int x = 0; x < width; ++x) {
+      const std::size_t i = std::size_t(y) * std::size_t(width) + std::size_t(x);
+      if (ids[i] == 0 || ids[i] > n) continue;
+      const ObjectId id = ids[i] - 1;
+      seen[id] = 1;
+      if (own_surface[id]) continue;
+      // Canonical depth (0 near, 1 far) to the stored window depth, then to clip space.
+      const double canonical = double(depth[i]) + reading;
+      const double stored = view.clip.reversed_z ? 1.0 - canonical : canonical;
+      const double ndc_z = view.clip.depth == DepthRange::zero_to_one ? stored : 2.0 * stored - 1.0;
+      if (canonical >= 1.0 || (view.clip.reversed_z && stored <= 0.0)) {
+        own_surface[id] = 1;  // at the far plane, or at infinity: nothing lies beyond
+        continue;
+      }
+      const double nx = (x + 0.5) / width * 2.0 - 1.0, ny = (y + 0.5) / height * 2.0 - 1.0;
+      const glm::dvec3 o = unproject(nx, ny, view.clip.near_depth());  // the ray on the near plane
+      const glm::dvec3 d = unproject(nx, ny, ndc_z) - o;               // ... to the pixel's depth: t = 1
+      const Aabb& b = scene.object(id).bounds;
+      const double slack =
+          std::ldexp(double(std::max({magnitude(b.min), magnitude(b.max), magnitude(view.eye)})), -16);
+      double enter = 0.0, leave = std::numeric_limits<double>::infinity();
+      for (int a = 0; a < 3; ++a) {
+        const double lo = double(b.min[a]) - slack, hi = double(b.max[a]) + slack;
+        if (d[a] == 0.0) {
+          if (o[a] < lo || o[a] > hi) leave = -1.0;
+          continue;
+        }
+        const double t0 = (lo - o[a]) / d[a], t1 = (hi - o[a]) / d[a];
+        enter = std::max(enter, std::min(t0, t1));
+        leave = std::min(leave, std::max(t0, t1));
+      }
+      const bool nearer_than_box = enter <= leave && enter * (1.0 - kDepthErrorTolerance) > 1.0;
+      if (!nearer_than_box) own_surface[id] = 1;
+    }
+  std::vector<ObjectId> only;
+  for (ObjectId id = 0; id < n; ++id)
+    if (seen[id] && !own_surface[id]) only.push_back(id);
+  return only;
 }
 
 std::vector<FrameTruth> Session::ground_truth(const CameraPath& path, int frames,
@@ -93,6 +153,8 @@ FrameTruth Session::truth_of(const View& view, const detail::FrameLabel& where) 
   t.probes = std::uint32_t(detail::check_truth_probes(where, scene, view, in_frustum, images.depth,
                                                        renderer_options_.cull_backfaces));
   t.coverage = detail::depth_coverage(images.depth);
+  t.depth_error_only = seen_only_through_depth_errors(scene, view, images.ids, images.depth, renderer_->width(),
+                                                      renderer_->height());
   return t;
 }
 
@@ -106,7 +168,7 @@ std::vector<ObjectId> Session::verify_frame(std::string_view name, const Culler&
   if (dynamic_cast<const detail::OracleCuller*>(&culler))
     detail::check_oracle_draws_truth(where, t.visible, recorder_->objects(), t.coverage.depth_hash,
                                      frame.depth_hash);
-  return check_frame(t.visible, recorder_->objects(), bundle_.scene.objects().size(), s);
+  return check_frame(t.visible, recorder_->objects(), bundle_.scene.objects().size(), s, t.depth_error_only);
 }
 
 void MissRuns::add(const std::vector<ObjectId>& missed) {

@@ -343,7 +343,8 @@ BenchResult run_osg_bench(const OsgBenchConfig& config, const ProgressFn& progre
         for (ObjectId id : drawn) stats.triangles += scene.object(id).triangles;
         if (config.verify) {
           const std::vector<ObjectId> missed =
-              check_frame(truth[std::size_t(k)].visible, drawn, scene.objects().size(), stats);
+              check_frame(truth[std::size_t(k)].visible, drawn, scene.objects().size(), stats,
+                          truth[std::size_t(k)].depth_error_only);
           misses.add(missed);
           if (!missed.empty() && run.first_miss.empty())
             run.first_miss = fmt::format("frame {}: {}", k, session.describe_object(missed.front()));
