@@ -3,7 +3,9 @@
 #   make test   install dependencies, build, run every test (ctest)
 #   make test-asan   the same tests built with AddressSanitizer, LeakSanitizer and UBSan
 #   make fuzz   fuzz every file reader for FUZZ_SECONDS each (libFuzzer, clang; build-fuzz/)
-#   make fuzz-regress   every reader over its corpus in tests/corpus/, then briefly fuzzed (CI)
+#   make fuzz-regress   every reader over its corpus in tests/corpus/, then briefly fuzzed, then a short
+#                       randomized campaign against the conservative cullers (CI)
+#   scripts/conservative-campaign.sh N   N random adversarial runs, every conservative culler verified
 BUILD ?= build
 JOBS ?= $(shell nproc)
 CMAKE_FLAGS ?=
@@ -35,8 +37,9 @@ fuzz-build:
 fuzz: fuzz-build
 	./scripts/fuzz.sh $(BUILD)-fuzz run $(FUZZ_SECONDS)
 
-fuzz-regress: fuzz-build
+fuzz-regress: fuzz-build build
 	./scripts/fuzz.sh $(BUILD)-fuzz regress
+	./scripts/conservative-campaign.sh 20 --short --seed 45 --occull $(BUILD)/occull
 
 deps:
 	./scripts/install-deps.sh

@@ -1,4 +1,6 @@
 // Runs the occull tool and checks exit codes and messages.
+#include "require_data.hpp"
+
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 #include <stb_image.h>
@@ -439,7 +441,7 @@ TEST(Cli, CorruptProfileIsAClearError) {
 
 TEST(Cli, ListMapsOfAnArchive) {
   const std::string pk3 = std::string(OCCULL_DATA_DIR) + "/openarena/pak1-maps.pk3";
-  if (!std::ifstream(pk3)) GTEST_SKIP() << pk3 << " missing: run make data";
+  OCCULL_REQUIRE_DATA(pk3);
   const CliRun r = run("scenes --list-maps " + pk3);
   EXPECT_EQ(r.code, 0) << r.output;
   EXPECT_NE(r.output.find("50 maps"), std::string::npos) << r.output;

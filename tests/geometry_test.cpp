@@ -90,6 +90,27 @@ TEST(Frustum, PlaneMaskDropsPlanesTheBoxIsFullyInside) {
   EXPECT_EQ(mask, 1u << Frustum::right);
 }
 
+// Far from the origin a float holds positions to millimetres (10 km): a
+// box that float arithmetic cannot tell from touching a plane is not
+// outside it; a box clearly past it is. (At 1,000 km the planes themselves,
+// taken from a float view-projection matrix, are metres off: that is why
+// coordinates are kept near a floating origin, docs/library.md.)
+TEST(Frustum, ABoxWithinTheRoundingOfAPlaneIsNotOutside) {
+  const glm::vec3 eye(1e4f, 0.0f, 1e4f);
+  const View v = make_view(CameraPose{eye, 0.0f, 0.0f}, Lens{90.0f, 0.1f, 100.0f}, 100, 100);
+  // The right plane is x - eye.x = -(z - eye.z); at z = eye.z - 11 it is at x = eye.x + 11.
+  const float z0 = eye.z - 11.0f, z1 = eye.z - 9.0f;
+  const Aabb touching{{eye.x + 11.0f, -1.0f, z0}, {eye.x + 12.0f, 1.0f, z1}};  // its corner on the plane
+  const Aabb cm_past{{eye.x + 11.01f, -1.0f, z0}, {eye.x + 12.0f, 1.0f, z1}};  // within the rounding here
+  const Aabb clearly_past{{eye.x + 21.0f, -1.0f, z0}, {eye.x + 30.0f, 1.0f, z1}};
+  EXPECT_NE(v.frustum.classify(touching), Containment::outside);
+  EXPECT_NE(v.frustum.classify(cm_past), Containment::outside);
+  EXPECT_EQ(v.frustum.classify(clearly_past), Containment::outside);
+  // Near the origin the same centimetre decides.
+  const View home = looking_down_minus_z();
+  EXPECT_EQ(home.frustum.classify({{11.01f, -1.0f, -11.0f}, {12.0f, 1.0f, -9.0f}}), Containment::outside);
+}
+
 TEST(Frustum, PlanesPointInwards) {
   const View v = looking_down_minus_z();
   for (int i = 0; i < Frustum::count; ++i)

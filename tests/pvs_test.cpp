@@ -3,6 +3,7 @@
 // (the BSP visdata lump, computed by the level's compiler) says are visible
 // from the eye's cluster.
 #include "gl_test_util.hpp"
+#include "require_data.hpp"
 #include "occull/harness.hpp"
 #include "occull/q3bsp.hpp"
 
@@ -83,7 +84,7 @@ Tally check_tour(const Level& level, const std::string& name, int frames) {
 }  // namespace
 
 TEST(OpenArenaPvs, TruthLiesInThePotentiallyVisibleSetOfTheEyesCluster) {
-  if (!std::filesystem::exists(kPk3)) GTEST_SKIP() << kPk3 << " missing: run make data";
+  OCCULL_REQUIRE_DATA(kPk3);
   for (const char* name : {"oasago2", "ctf_inyard", "oa_dm1", "hydronex", "oa_rpg3dm2"}) {
     const Level level = load_level(name);
     ASSERT_GT(level.map.vis.clusters, 1) << name << " carries a PVS";
@@ -100,7 +101,7 @@ TEST(OpenArenaPvs, TruthLiesInThePotentiallyVisibleSetOfTheEyesCluster) {
 TEST(OpenArenaPvs, ACutDownPvsIsCaught) {
   // Break the map's PVS on purpose (each cluster sees only itself): the
   // cross-check must report truth objects outside it.
-  if (!std::filesystem::exists(kPk3)) GTEST_SKIP() << kPk3 << " missing: run make data";
+  OCCULL_REQUIRE_DATA(kPk3);
   Level level = load_level("oasago2");
   q3::VisData& v = level.map.vis;
   std::fill(v.bits.begin(), v.bits.end(), 0);

@@ -3,6 +3,7 @@
 #include "occull/bvh.hpp"
 #include "occull/error.hpp"
 #include "occull/q3bsp.hpp"
+#include "require_data.hpp"
 #include "tiny_bsp.hpp"
 
 #include <gtest/gtest.h>
@@ -104,19 +105,17 @@ namespace {
 
 const std::string kPk3 = std::string(OCCULL_DATA_DIR) + "/openarena/pak1-maps.pk3";
 
-bool have_data() { return std::filesystem::exists(kPk3); }
-
 }  // namespace
 
 TEST(OpenArena, ArchiveListsItsFiftyMaps) {
-  if (!have_data()) GTEST_SKIP() << kPk3 << " missing: run make data";
+  OCCULL_REQUIRE_DATA(kPk3);
   const auto maps = q3::list_maps(kPk3);
   EXPECT_EQ(maps.size(), 50u);
   EXPECT_NE(std::find(maps.begin(), maps.end(), "oasago2"), maps.end());
 }
 
 TEST(OpenArena, MapsLoadWithTheTriangleCountsOfTheirFaces) {
-  if (!have_data()) GTEST_SKIP() << kPk3 << " missing: run make data";
+  OCCULL_REQUIRE_DATA(kPk3);
   // Polygon + mesh triangles (REFERENCE.md) and curved patches.
   struct Expect {
     const char* map;

@@ -22,11 +22,13 @@ SoakConfig tiny() {
   return c;
 }
 
-SoakWindow window(std::uint64_t resident, std::size_t queries) {
+// A window's end: `queries` in the pool, `held` of them in flight.
+SoakWindow window(std::uint64_t resident, std::size_t queries, std::size_t held = 0) {
   SoakWindow w;
   w.median_ms = 1.0;
   w.resident_bytes = resident;
   w.gl.queries = queries;
+  w.gl.queries_free = queries - held;
   w.gl.buffer_bytes = 1000;
   return w;
 }
@@ -71,26 +73,54 @@ TEST(Soak, RunsEveryAlgorithmOverItsWindowsOnTheTurnPathReportingMemoryAndGlObje
             r.runs[0].windows[0].heap_held_bytes);
 }
 
-TEST(Soak, MemoryThatGrowsPastTheToleranceIsJudgedGrown) {
+TEST(Soak, MemoryThatKeepsGrowingIsALeakAndAHighWaterMarkIsNot) {
   SoakRun run;
   run.windows = {window(100 << 20, 50), window(104 << 20, 50)};
   judge_soak_run(run, 0.05);
-  EXPECT_TRUE(run.memory_flat);
-  run.windows.push_back(window(106 << 20, 50));
+  EXPECT_EQ(run.memory, SoakTrend::flat);
+  run.windows.push_back(window(106 << 20, 50));  // past 5 %, rising in every step
   judge_soak_run(run, 0.05);
-  EXPECT_FALSE(run.memory_flat);
-  EXPECT_TRUE(run.pool_flat);
+  EXPECT_EQ(run.memory, SoakTrend::growing);
+  EXPECT_FALSE(run.leak_free());
+  EXPECT_EQ(run.pool, SoakTrend::flat);
+  run.windows.push_back(window(106 << 20, 50));  // and then it stops
+  judge_soak_run(run, 0.05);
+  EXPECT_EQ(run.memory, SoakTrend::plateau);
+  EXPECT_TRUE(run.leak_free());
 }
 
-TEST(Soak, AQueryPoolThatGrowsPastTheToleranceIsJudgedGrown) {
+// The issue-45 case: chcpp's pool rose 52 -> 56 once, every query back in
+// the pool at every window's end: a high-water mark, not a leak.
+TEST(Soak, AQueryPoolThatRoseOnceIsAHighWaterMark) {
   SoakRun run;
-  run.windows = {window(100 << 20, 100), window(100 << 20, 105)};
+  for (std::size_t q : {52, 52, 56, 56, 56}) run.windows.push_back(window(100 << 20, q));
   judge_soak_run(run, 0.05);
-  EXPECT_TRUE(run.pool_flat);
-  run.windows.push_back(window(100 << 20, 106));
+  EXPECT_EQ(run.pool, SoakTrend::plateau);
+  EXPECT_EQ(run.in_use, SoakTrend::flat);
+  EXPECT_TRUE(run.leak_free());
+}
+
+TEST(Soak, AQueryPoolThatGrowsEveryWindowIsALeak) {
+  SoakRun run;
+  for (std::size_t q : {118, 180, 240, 300}) run.windows.push_back(window(100 << 20, q));
   judge_soak_run(run, 0.05);
-  EXPECT_FALSE(run.pool_flat);
-  EXPECT_TRUE(run.memory_flat);
+  EXPECT_EQ(run.pool, SoakTrend::growing);
+  EXPECT_FALSE(run.leak_free());
+}
+
+TEST(Soak, QueriesHeldAtWindowEndsThatKeepGrowingAreALeak) {
+  SoakRun run;
+  for (std::size_t held : {0, 10, 20, 30}) run.windows.push_back(window(100 << 20, 400, held));
+  judge_soak_run(run, 0.05);
+  EXPECT_EQ(run.pool, SoakTrend::flat);
+  EXPECT_EQ(run.in_use, SoakTrend::growing);
+  EXPECT_FALSE(run.leak_free());
+}
+
+TEST(Soak, TrendsOfFiguresNotGivenAreFlat) {
+  EXPECT_EQ(soak_trend(std::vector<double>{}, 0.05), SoakTrend::flat);
+  EXPECT_EQ(soak_trend(std::vector<double>{5.0}, 0.05), SoakTrend::flat);
+  EXPECT_EQ(soak_trend(std::vector<double>{0.0, 0.0, 0.0}, 0.05), SoakTrend::flat);
 }
 
 TEST(Soak, FramesThatAreNotAWholeNumberOfWindowsAreRejected) {

@@ -51,7 +51,7 @@ constexpr int kExitInternal = 1;
 constexpr int kExitInput = 2;
 constexpr int kExitNoGl = 3;
 constexpr int kExitVerificationFailed = 4;
-constexpr int kExitSoakGrew = 5;
+constexpr int kExitSoakLeak = 5;
 
 constexpr const char* kMallocHelp =
     "allocator policy of the process: engine (keep freed heap memory, as engines do, so driver batches do "
@@ -795,7 +795,7 @@ int cmd_soak(const SoakArgs& a) {
     json->flush();
     check_written(*json, a.json);
   }
-  return occull::soak_flat(result) ? 0 : kExitSoakGrew;
+  return occull::soak_flat(result) ? 0 : kExitSoakLeak;
 }
 
 struct TraverseArgs {
@@ -927,7 +927,7 @@ constexpr std::pair<int, const char*> kExitCodes[] = {
     {2, "bad input: unknown scene / path / algorithm / option (the message lists the valid ones), invalid number or size, a damaged level, model, path or profile file (the message names the file and the fault), an output file or folder that cannot be written"},
     {3, "no usable OpenGL 4.5: EGL or the driver is missing (the message says which package); `view`: no display, or built without its viewer"},
     {4, "`bench`, `osg`: verification failed — a conservative algorithm culled a visible object (the table, JSON and report are written first)"},
-    {5, "`soak`: resident memory or the query pool grew more than 5 % from the first window to the last (the table and JSON are written first)"},
+    {5, "`soak`: a leak — resident memory, the query pool, the queries held at a window's end or the buffers more than 5 % above the first window and still growing over the last windows (a high-water mark reached is not one; the table and JSON are written first)"},
 };
 
 std::string exit_code_table() {

@@ -327,7 +327,7 @@ int run_viewer(const ViewArgs& a) {
       session.release(*culler);  // its queries live on occull's context
       culler = std::move(next_culler);
     }
-    const View view = make_view(camera.pose, session.bundle().lens, width, height);
+    const View view = session.view_of(camera.pose);  // the floating origin follows the camera
     FrameLog log;
     const FrameStats stats = session.run_frame(*culler, view, time_s, &log);
     image = session.renderer().read_rgba();

@@ -140,7 +140,11 @@ class Frustum {
 
   /// Classifies a box. Conservative: may answer `intersecting` for a box that
   /// is outside near a frustum corner, never `outside` for a box that overlaps.
-  /// An empty box is `outside`.
+  /// A box is `outside` a plane only when it lies beyond it by more than the
+  /// rounding of the plane's float arithmetic at the box's coordinates
+  /// (a few units in the last place of |n.x x| + |n.y y| + |n.z z| + |d|):
+  /// where float precision cannot tell, far from the origin, it is not
+  /// outside. An empty box is `outside`.
   /// `plane_mask` selects the planes to test (bit i = plane i); on return it
   /// holds the planes the box still straddles, so children of an
   /// `intersecting` node can skip the planes their parent was fully inside.

@@ -154,6 +154,13 @@ class Scene {
   ObjectId add_dynamic_object(MeshId mesh, MaterialId material, Motion motion,
                               OccluderClass occluder, const glm::mat4& local = glm::mat4(1.0f));
 
+  /// Replaces motion `index` of motions(): the dynamic objects on it follow
+  /// the new one from their next update() (an engine that re-routes them, or
+  /// moves its floating origin). Throws InputError, the scene unchanged, for
+  /// an index out of range or a motion without 2 finite waypoints and a
+  /// finite speed > 0.
+  void set_motion(std::size_t index, Motion motion);
+
   /// Makes static object `id` another object in place: its mesh, material,
   /// transform and class (a tiled world reuses the ids of a tile that left
   /// its window for the one that entered). Bounds and triangles follow.

@@ -40,6 +40,11 @@ struct SceneBundle {
   Scene scene;
   std::vector<CameraPath> paths;  ///< default first
   Lens lens;
+  /// Where the scene's frame stands in the world, metres (the `offset`
+  /// parameter: (offset, 0, offset)): its objects and paths are relative to
+  /// it. A Session keeps its scene relative to a floating origin near the
+  /// camera instead (Session::origin).
+  glm::dvec3 origin{0.0};
   /// Set for a tiled world (tiles_city, ...): the scene holds its window of
   /// objects, and the owner calls world->follow(scene, eye) before each
   /// frame it renders (occull/tiles.hpp).

@@ -64,25 +64,30 @@ struct FrameTruth {
 };
 
 /// The share of the distance from the eye by which a pixel's depth may lie
-/// nearer than where the pixel's ray enters its object's box and still be
-/// taken as the object's own surface (seen_only_through_depth_errors).
-inline constexpr double kDepthErrorTolerance = 0.01;
+/// nearer than where the pixel's ray enters its object's box (grown as
+/// seen_only_through_depth_errors says) and still be taken as the object's
+/// own surface: arithmetic noise of the check itself.
+inline constexpr double kDepthErrorTolerance = 1e-4;
 
 /// The objects of an id image (row-major, bottom row first; 0 background,
 /// else id + 1) every one of whose pixels lies, by the depth image beside
 /// it (canonical window depth, read_depth()), nearer to the eye than where
 /// the pixel centre's ray enters the object's box — by more than
 /// kDepthErrorTolerance of that distance, with the depth read at its
-/// farthest within float precision and the box grown by its coordinates'
-/// float precision. No surface of the object lies there: the rasteriser
-/// put it there. Mesa's llvmpipe does, in its early depth test, for
-/// sub-pixel sliver triangles (a terrain seen edge-on far away): it
-/// extrapolates their depth far outside their vertices' range, so a tile
-/// 528 m away shows one pixel at 206 m, through a rock at 417 m
-/// (docs/instrument.md, "Depth errors of the rasteriser"). A pixel whose
-/// ray misses the box (snapping widened the outline) or starts inside it
-/// counts as the object's own. Ascending ids. Preconditions: ids and depth
-/// hold width * height values, `view` is the one they were drawn with.
+/// farthest within float precision (4 units in the last place of a window
+/// depth near 1) and the box grown by what a correct rasteriser may put between a
+/// surface and its pixels (2^-16 of the coordinates' magnitude for their
+/// float precision, and a 64th of a pixel at that depth for vertex
+/// snapping). No surface of the object lies there: the rasteriser put it
+/// there. Mesa's llvmpipe does, in its early depth test, for sub-pixel
+/// sliver triangles (a terrain seen edge-on far away, a pole's foot seen
+/// from 0.4 m above the ground): it extrapolates their depth outside their
+/// vertices' range, so a tile 528 m away shows one pixel at 206 m, through
+/// a rock at 417 m (docs/instrument.md, "Depth errors of the rasteriser").
+/// A pixel whose ray misses the box (snapping widened the outline) or
+/// starts inside it counts as the object's own. Ascending ids.
+/// Preconditions: ids and depth hold width * height values, `view` is the
+/// one they were drawn with.
 [[nodiscard]] std::vector<ObjectId> seen_only_through_depth_errors(const Scene& scene, const View& view,
                                                                    std::span<const std::uint32_t> ids,
                                                                    std::span<const float> depth, int width,
@@ -325,8 +330,35 @@ class Session {
   [[nodiscard]] double frame_time(const CameraPath& path, int k, int frames) const {
     return path.frame_time(k, frames, sampling_);
   }
-  /// View of `path` at frame k of `frames`.
-  [[nodiscard]] View view_at(const CameraPath& path, int k, int frames) const;
+  /// View of `path` at frame k of `frames`: view_of its pose.
+  [[nodiscard]] View view_at(const CameraPath& path, int k, int frames);
+  /// The view of a pose of the scene's paths (relative to the bundle's
+  /// origin), in the frame the scene is in for it: the floating origin
+  /// moves to the cell of the camera first (re-placing every object when
+  /// it changes; see origin()). Use the view before asking for another.
+  [[nodiscard]] View view_of(CameraPose pose);
+
+  /// The floating origin: where the frame of occull's coordinates (the
+  /// scene's objects, its hierarchy, views) stands in the world, metres. As
+  /// an engine keeps a large world, the session keeps it near the camera: at
+  /// the centre of the cell of side origin_grid() the camera is in (a pure
+  /// function of the camera, so every pass over a frame sees the same
+  /// placements). When it moves, every object is placed anew from where the
+  /// scene put it, in double precision — an engine's own set_transform calls
+  /// between frames; the hierarchy refits and the cullers keep their state.
+  /// Changes the engine made to objects' transforms are lost then.
+  /// docs/library.md, "Far from the origin". Tiled worlds keep theirs at 0.
+  [[nodiscard]] const glm::dvec3& origin() const noexcept { return origin_; }
+  [[nodiscard]] double origin_grid() const noexcept { return origin_grid_; }
+  /// Where the floating origin stands for a camera at `pose` (a pose of the
+  /// scene's paths): the centre of the camera's cell. Tiled worlds: origin().
+  [[nodiscard]] glm::dvec3 origin_for(const CameraPose& pose) const;
+  /// How many times the floating origin moved since the session began.
+  [[nodiscard]] std::uint64_t origin_moves() const noexcept { return origin_moves_; }
+  /// The side of the floating origin's cells, metres (> 0), from the next
+  /// view on. Default kOriginGrid. Throws InputError for a side <= 0 or not finite.
+  void set_origin_grid(double metres);
+  static constexpr double kOriginGrid = 4096.0;
 
   [[nodiscard]] const SceneBundle& bundle() const noexcept { return bundle_; }
   /// The scene, for an engine's changes between frames (set_transform,
@@ -348,8 +380,20 @@ class Session {
   double bvh_build_ms_ = 0.0;
   std::string scene_spec_;
   SceneBundle bundle_;
-  std::vector<ObjectId> engine_moved_;      // set_engine_moves: the objects moved
-  std::vector<glm::mat4> engine_home_;      // ... and where they stood
+  std::vector<ObjectId> engine_moved_;      // set_engine_moves: the objects moved (from home_)
+  // The floating origin (see origin()): where the scene's frame stands now,
+  // the cells it snaps to, and every object's transform and every motion as
+  // the scene was made (relative to bundle_.origin), placed anew from them
+  // when the origin moves, so a placement depends on the origin alone.
+  glm::dvec3 origin_{0.0};
+  double origin_grid_ = kOriginGrid;
+  std::uint64_t origin_moves_ = 0;
+  std::vector<glm::mat4> home_;
+  std::vector<Motion> home_motions_;
+  // `home` (relative to bundle_.origin) relative to origin_, in double.
+  [[nodiscard]] glm::mat4 placed(const glm::mat4& home) const;
+  // Moves the scene's frame to `origin` (world), re-placing every object and motion.
+  void move_origin(const glm::dvec3& origin);
   // The scene at path time `time_s`: Motions, then the engine's moves.
   void advance_scene(double time_s);
   Bvh bvh_;

@@ -11,6 +11,7 @@
 #include <cstdint>
 #include <functional>
 #include <iosfwd>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -30,7 +31,8 @@ struct SoakConfig {
   double stall_guard_ms = 0.0;   ///< Session::set_stall_guard
   double watchdog_s = Session::kWatchdogSeconds;
   /// Flat: the last window's end is within this share above the first's
-  /// (resident memory, queries created, buffer bytes; see judge_soak_run).
+  /// (resident memory, queries created and in use, buffer bytes); past it a
+  /// figure still growing is a leak (soak_trend).
   double tolerance = 0.05;
 };
 
@@ -47,24 +49,44 @@ struct SoakWindow {
   gl::Renderer::Resources gl;        ///< the renderer's query pool and buffers
 };
 
+/// How one figure of a soak run went over its windows.
+enum class SoakTrend : std::uint8_t {
+  flat,     ///< within the tolerance of the first window all along
+  plateau,  ///< grew past it, then stopped: a high-water mark reached (not a leak)
+  growing,  ///< past it and still growing in each of the last windows: a leak
+};
+
 struct SoakRun {
   std::string algorithm;
   std::vector<SoakWindow> windows;
   double time_drift = 1.0;  ///< last window's median frame time over the first's
-  bool memory_flat = true;  ///< resident memory: last window within tolerance of the first
-  bool pool_flat = true;    ///< queries created and buffer bytes: likewise
+  SoakTrend memory = SoakTrend::flat;   ///< resident memory
+  SoakTrend pool = SoakTrend::flat;     ///< queries the renderer created (the most ever in flight at once)
+  SoakTrend in_use = SoakTrend::flat;   ///< queries not back in the pool at a window's end (held in flight)
+  SoakTrend buffers = SoakTrend::flat;  ///< the renderer's buffer bytes
+  /// No figure growing: what a soak passes on.
+  [[nodiscard]] bool leak_free() const noexcept {
+    return memory != SoakTrend::growing && pool != SoakTrend::growing && in_use != SoakTrend::growing &&
+           buffers != SoakTrend::growing;
+  }
 };
 
-/// Sets `run`'s verdicts from its first and last windows. Memory is judged
-/// on the resident set. Under glibc's defaults (the soak's `--malloc
-/// system`) the heap hands freed memory at its top back, so a leak shows as
-/// growth and a passing peak mostly does not. Under the engine policy freed
-/// memory is kept, so the resident set is the heap's high-water mark: it
-/// also grows with a rare peak of what the driver holds and with the heap's
-/// fragmentation (heap held shows this). The heap in use is reported but
-/// not judged (it swings by tens of MiB with what the driver holds at the
-/// moment it is read). The query pool is the most queries ever in use at
-/// once, so it may creep up with a rare peak; a leak grows it by the frames.
+/// A figure's trend over windows (its value at each window's end): flat
+/// when the last is within `tolerance` (a share) above the first; else
+/// growing when it rose from each window to the next over the last
+/// min(3, windows - 1) of them, plateau when it did not. A leak grows a
+/// figure with the frames; a pool or a heap that grew to the most a run ever
+/// needed at once and stays there does not (the query pool is such a
+/// high-water mark: a rare peak in flight adds a few queries once).
+[[nodiscard]] SoakTrend soak_trend(std::span<const double> values, double tolerance);
+
+/// Sets `run`'s trends from its windows. Memory is judged on the resident
+/// set. Under glibc's defaults (the soak's `--malloc system`) the heap hands
+/// freed memory at its top back; under the engine policy freed memory is
+/// kept, so the resident set is the heap's high-water mark (heap held shows
+/// its fragmentation): either way a leak keeps growing it, a peak does not.
+/// The heap in use is reported but not judged (it swings by tens of MiB
+/// with what the driver holds at the moment it is read).
 void judge_soak_run(SoakRun& run, double tolerance);
 
 struct SoakResult {
@@ -99,7 +121,7 @@ void print_soak(const SoakResult& result, std::ostream& out);
 [[nodiscard]] std::string soak_verdict(const SoakResult& result);
 /// The same as JSON ("format": "occull soak 1").
 void write_soak_json(const SoakResult& result, std::ostream& out);
-/// Whether every run's memory and GL objects stayed flat.
+/// Whether no run leaks (SoakRun::leak_free): exit 5 of `occull soak` otherwise.
 [[nodiscard]] bool soak_flat(const SoakResult& result) noexcept;
 
 }  // namespace occull

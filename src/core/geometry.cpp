@@ -77,7 +77,14 @@ Containment Frustum::classify(const Aabb& box, std::uint32_t& plane_mask) const 
     const glm::vec3 far_corner(p.n.x >= 0 ? box.max.x : box.min.x,
                                p.n.y >= 0 ? box.max.y : box.min.y,
                                p.n.z >= 0 ? box.max.z : box.min.z);
-    if (p.signed_distance(far_corner) < 0.0f) return Containment::outside;
+    const float beyond = p.signed_distance(far_corner);
+    if (beyond < 0.0f) {
+      // Outside only past the rounding of that sum (8 float units in the last
+      // place of its largest possible term): undecidable is not outside.
+      const float scale = std::abs(p.n.x * far_corner.x) + std::abs(p.n.y * far_corner.y) +
+                          std::abs(p.n.z * far_corner.z) + std::abs(p.d);
+      if (beyond < -8.0f * std::numeric_limits<float>::epsilon() * scale) return Containment::outside;
+    }
     const glm::vec3 near_corner(p.n.x >= 0 ? box.min.x : box.max.x,
                                 p.n.y >= 0 ? box.min.y : box.max.y,
                                 p.n.z >= 0 ? box.min.z : box.max.z);

@@ -187,6 +187,20 @@ ObjectId Scene::add_dynamic_object(MeshId mesh, MaterialId material, Motion moti
   return id;
 }
 
+void Scene::set_motion(std::size_t index, Motion motion) {
+  if (index >= motions_.size())
+    throw InputError(fmt::format("scene {}: set_motion of motion {}: the scene has {}", name_, index, motions_.size()));
+  const bool finite_points = std::all_of(motion.waypoints.begin(), motion.waypoints.end(), [](const glm::vec3& p) {
+    return std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z);
+  });
+  if (motion.waypoints.size() < 2 || !finite_points || !std::isfinite(motion.speed) || motion.speed <= 0.0f ||
+      !std::isfinite(motion.start_offset))
+    throw InputError(fmt::format("scene {}: set_motion of motion {}: needs 2 or more finite waypoints and a finite "
+                                 "speed > 0",
+                                 name_, index));
+  motions_[index] = std::move(motion);
+}
+
 void Scene::place_object(ObjectId id, MeshId mesh, MaterialId material, const glm::mat4& transform,
                          OccluderClass occluder) {
   assert(id < objects_.size() && !objects_[id].dynamic());

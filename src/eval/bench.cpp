@@ -19,7 +19,11 @@ namespace {
 // How far the camera moves and turns between consecutive frames of a run.
 void measure_camera_motion(const Session& session, const CameraPath& path, int frames, BenchResult& r) {
   for (int k = 1; k < frames; ++k) {
-    const View a = session.view_at(path, k - 1, frames), b = session.view_at(path, k, frames);
+    // Views of the path's own poses: relative to the scene as made, not to the floating origin.
+    const auto view = [&](int f) {
+      return make_view(path.sample(session.frame_time(path, f, frames)), session.bundle().lens, 1, 1);
+    };
+    const View a = view(k - 1), b = view(k);
     const double step = glm::length(b.eye - a.eye);
     // Forward is -Z of the view: the third row of the view matrix, negated.
     const glm::vec3 fa(-a.view[0][2], -a.view[1][2], -a.view[2][2]), fb(-b.view[0][2], -b.view[1][2], -b.view[2][2]);
@@ -325,6 +329,14 @@ BenchResult run_bench(const BenchConfig& config, const ProgressFn& progress) {
     }
   }
   result.summaries = summarize_runs(result.runs);
+  if (session.bundle().origin != glm::dvec3(0.0) || session.origin_moves() > 0) {
+    const glm::dvec3 o = session.origin();
+    result.conditions += fmt::format("{}scene {:.0f} m out along x and z: occull's coordinates relative to a floating "
+                                     "origin near the camera, last at ({:.0f}, {:.0f}, {:.0f}), cells of {:g} m, "
+                                     "moved {} times",
+                                     result.conditions.empty() ? "" : "; ", session.bundle().origin.x, o.x, o.y, o.z,
+                                     session.origin_grid(), session.origin_moves());
+  }
   return result;
 }
 

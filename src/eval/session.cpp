@@ -24,6 +24,9 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
+// The centre of the cell of side `grid` that world point `p` is in.
+glm::dvec3 origin_cell(const glm::dvec3& p, double grid) { return glm::round(p / grid) * grid; }
+
 double ms_between(Clock::time_point a, Clock::time_point b) {
   return std::chrono::duration<double, std::milli>(b - a).count();
 }
@@ -53,6 +56,12 @@ Session::Session(std::string name, SceneBundle bundle, const gl::RendererOptions
 
 void Session::start(const gl::RendererOptions& renderer_options, const BvhOptions& bvh_options) {
   const auto t0 = Clock::now();
+  // The floating origin: the scene's frame starts where the scene was made,
+  // then snaps to its cell (a scene far out is re-placed near it at once).
+  origin_ = bundle_.origin;
+  for (const Object& o : bundle_.scene.objects()) home_.push_back(o.transform);
+  home_motions_.assign(bundle_.scene.motions().begin(), bundle_.scene.motions().end());
+  if (!bundle_.world) move_origin(origin_cell(bundle_.origin, origin_grid_));
   // A tiled world has no global hierarchy: its cullers keep one BVH
   // instance per tile (occull/tiles.hpp).
   bvh_ = bundle_.world ? Bvh::build(std::span<const Aabb>{}, std::span<const std::uint32_t>{})
@@ -129,9 +138,48 @@ const CameraPath& Session::path(std::string_view name) {
   return bundle_.path(name);
 }
 
-View Session::view_at(const CameraPath& path, int k, int frames) const {
-  return make_view(path.sample(frame_time(path, k, frames)), bundle_.lens, renderer_->width(),
-                   renderer_->height());
+View Session::view_at(const CameraPath& path, int k, int frames) {
+  return view_of(path.sample(frame_time(path, k, frames)));
+}
+
+glm::dvec3 Session::origin_for(const CameraPose& pose) const {
+  if (bundle_.world) return origin_;
+  return origin_cell(bundle_.origin + glm::dvec3(pose.position), origin_grid_);
+}
+
+View Session::view_of(CameraPose pose) {
+  if (!bundle_.world) {
+    move_origin(origin_for(pose));
+    pose.position = glm::vec3(bundle_.origin + glm::dvec3(pose.position) - origin_);
+  }
+  return make_view(pose, bundle_.lens, renderer_->width(), renderer_->height());
+}
+
+void Session::set_origin_grid(double metres) {
+  if (!(metres > 0.0) || !std::isfinite(metres))
+    throw InputError(fmt::format("origin grid {} m: must be a number of metres > 0", metres));
+  origin_grid_ = metres;
+}
+
+glm::mat4 Session::placed(const glm::mat4& home) const {
+  glm::dmat4 m(home);
+  m[3] += glm::dvec4(bundle_.origin - origin_, 0.0);
+  return glm::mat4(m);
+}
+
+void Session::move_origin(const glm::dvec3& origin) {
+  if (origin == origin_) return;
+  origin_ = origin;
+  ++origin_moves_;
+  Scene& scene = bundle_.scene;
+  for (ObjectId id = 0; id < home_.size(); ++id)
+    if (scene.alive(id) && !scene.object(id).dynamic()) scene.set_transform(id, placed(home_[id]));
+  const glm::dvec3 shift = bundle_.origin - origin_;
+  for (std::size_t i = 0; i < home_motions_.size(); ++i) {
+    Motion m = home_motions_[i];
+    for (glm::vec3& p : m.waypoints) p = glm::vec3(glm::dvec3(p) + shift);
+    scene.set_motion(i, std::move(m));
+  }
 }
 
 FrameStats Session::run_frame(Culler& culler, const View& view, double time_s, FrameLog* log) {
@@ -183,17 +231,13 @@ void Session::set_engine_moves(double fraction) {
   if (bundle_.world && fraction > 0.0)
     throw InputError(fmt::format("{}: a tiled world places its own objects; engine moves are for other scenes",
                                  scene_spec_));
-  for (std::size_t i = 0; i < engine_moved_.size(); ++i)  // back where they stood
-    bundle_.scene.set_transform(engine_moved_[i], engine_home_[i]);
+  for (ObjectId id : engine_moved_)  // back where they stood
+    if (bundle_.scene.alive(id)) bundle_.scene.set_transform(id, placed(home_[id]));
   engine_moved_.clear();
-  engine_home_.clear();
   if (fraction <= 0.0) return;
   const auto every = std::max<ObjectId>(1, ObjectId(std::lround(1.0 / fraction)));
-  for (ObjectId id = 0; id < bundle_.scene.objects().size(); id += every)
-    if (bundle_.scene.alive(id) && !bundle_.scene.object(id).dynamic()) {
-      engine_moved_.push_back(id);
-      engine_home_.push_back(bundle_.scene.object(id).transform);
-    }
+  for (ObjectId id = 0; id < home_.size(); id += every)
+    if (bundle_.scene.alive(id) && !bundle_.scene.object(id).dynamic()) engine_moved_.push_back(id);
 }
 
 void Session::advance_scene(double time_s) {
@@ -201,7 +245,8 @@ void Session::advance_scene(double time_s) {
   for (std::size_t i = 0; i < engine_moved_.size(); ++i) {
     const double angle = time_s * (2.0 * 3.14159265358979 / 4.0) + 0.7 * double(i);
     const glm::vec3 offset(float(std::cos(angle)), 0.0f, float(std::sin(angle)));
-    bundle_.scene.set_transform(engine_moved_[i], glm::translate(glm::mat4(1.0f), offset) * engine_home_[i]);
+    bundle_.scene.set_transform(engine_moved_[i],
+                                glm::translate(glm::mat4(1.0f), offset) * placed(home_[engine_moved_[i]]));
   }
 }
 

@@ -17,10 +17,17 @@ namespace {
 
 double mib(std::uint64_t bytes) { return double(bytes) / double(1 << 20); }
 
-// Whether `last` is within `tolerance` above `first` (a figure the OS or C
-// library did not give, 0, is not judged).
-bool within(double first, double last, double tolerance) {
-  return first <= 0.0 || last <= first * (1.0 + tolerance);
+// A trend's JSON name and its words in the verdict line.
+struct TrendWords {
+  std::string_view name, text;
+};
+TrendWords words(SoakTrend t) {
+  switch (t) {
+    case SoakTrend::plateau: return {"plateau", "grew, then stopped: a high-water mark"};
+    case SoakTrend::growing: return {"growing", "STILL GROWING: a leak"};
+    case SoakTrend::flat: break;
+  }
+  return {"flat", "flat"};
 }
 
 void check(const SoakConfig& c) {
@@ -49,8 +56,7 @@ void soak_one(Session& session, SoakRun& run, const SoakConfig& c, const CameraP
   for (std::int64_t k = 0; k < total; ++k) {
     const double t = double(k) / c.fps;
     const double on_path = loop > 0.0 ? std::fmod(t, loop) : 0.0;
-    const View view = make_view(path.sample(path.keys().front().time + on_path), session.bundle().lens,
-                                session.renderer().width(), session.renderer().height());
+    const View view = session.view_of(path.sample(path.keys().front().time + on_path));
     const FrameStats s = session.run_frame(*culler, view, t);
     if (progress && (k % 500 == 0 || k + 1 == total)) progress(name, k + 1, total);
     if (k < c.warmup) continue;
@@ -83,14 +89,32 @@ void soak_one(Session& session, SoakRun& run, const SoakConfig& c, const CameraP
 
 }  // namespace
 
+SoakTrend soak_trend(std::span<const double> values, double tolerance) {
+  if (values.size() < 2) return SoakTrend::flat;
+  const double first = values.front(), last = values.back();
+  // A figure the OS or C library did not give (0) is not judged; a count
+  // that starts at 0 (no query held) is judged by its rises alone.
+  if (first < 0.0 || last <= first * (1.0 + tolerance) || (first == 0.0 && last == 0.0)) return SoakTrend::flat;
+  const std::size_t steps = std::min<std::size_t>(3, values.size() - 1);
+  for (std::size_t i = values.size() - steps; i < values.size(); ++i)
+    if (!(values[i] > values[i - 1])) return SoakTrend::plateau;
+  return SoakTrend::growing;
+}
+
 void judge_soak_run(SoakRun& run, double tolerance) {
   if (run.windows.empty()) return;
   const SoakWindow& a = run.windows.front();
   const SoakWindow& b = run.windows.back();
   run.time_drift = a.median_ms > 0.0 ? b.median_ms / a.median_ms : 1.0;
-  run.memory_flat = within(double(a.resident_bytes), double(b.resident_bytes), tolerance);
-  run.pool_flat = within(double(a.gl.queries), double(b.gl.queries), tolerance) &&
-                  within(double(a.gl.buffer_bytes), double(b.gl.buffer_bytes), tolerance);
+  const auto trend = [&](auto figure) {
+    std::vector<double> v;
+    for (const SoakWindow& w : run.windows) v.push_back(double(figure(w)));
+    return soak_trend(v, tolerance);
+  };
+  run.memory = trend([](const SoakWindow& w) { return w.resident_bytes; });
+  run.pool = trend([](const SoakWindow& w) { return w.gl.queries; });
+  run.in_use = trend([](const SoakWindow& w) { return w.gl.queries - w.gl.queries_free; });
+  run.buffers = trend([](const SoakWindow& w) { return w.gl.buffer_bytes; });
 }
 
 SoakResult run_soak(const SoakConfig& config, const SoakProgress& progress, std::ostream* live) {
@@ -113,7 +137,7 @@ SoakResult run_soak(const SoakConfig& config, const SoakProgress& progress, std:
   if (live) *live << soak_header(result) << std::flush;
   result.runs.reserve(config.algorithms.size());
   for (const auto& name : config.algorithms) {
-    result.runs.push_back({name, {}, 1.0, true, true});
+    result.runs.push_back({name, {}, 1.0});
     soak_one(session, result.runs.back(), config, path, progress, live);
   }
   if (live) *live << soak_verdict(result) << std::flush;
@@ -149,20 +173,24 @@ std::string soak_run_verdict(const SoakRun& r) {
   const auto growth = [](std::uint64_t first, std::uint64_t last) {
     return first ? 100.0 * (double(last) / double(first) - 1.0) : 0.0;
   };
-  return fmt::format("{}: memory {} (RSS {:+.1f}%; heap held {:+.1f}%, not judged), query pool and buffers {} "
-                     "({} -> {} queries), median frame time x{:.3f}, last window vs first\n",
-                     r.algorithm, r.memory_flat ? "flat" : "GREW", growth(a.resident_bytes, b.resident_bytes),
-                     growth(a.heap_held_bytes, b.heap_held_bytes), r.pool_flat ? "flat" : "GREW", a.gl.queries, b.gl.queries, r.time_drift);
+  return fmt::format("{}: memory {} (RSS {:+.1f}%; heap held {:+.1f}%, not judged); query pool {} ({} -> {}); "
+                     "queries held at a window's end {} ({} -> {}); buffers {}; median frame time x{:.3f}, last "
+                     "window vs first\n",
+                     r.algorithm, words(r.memory).text, growth(a.resident_bytes, b.resident_bytes),
+                     growth(a.heap_held_bytes, b.heap_held_bytes), words(r.pool).text, a.gl.queries, b.gl.queries,
+                     words(r.in_use).text, a.gl.queries - a.gl.queries_free, b.gl.queries - b.gl.queries_free,
+                     words(r.buffers).text, r.time_drift);
 }
 
 std::string soak_verdict(const SoakResult& result) {
-  return fmt::format("\nverdict: {} (flat: the last window's end within {:.0f}% of the first's)\n",
-                     soak_flat(result) ? "flat" : "GREW", 100.0 * result.config.tolerance);
+  return fmt::format("\nverdict: {} (a leak: a figure more than {:.0f}% above its first window's and still growing "
+                     "over the last windows; one that grew to a high-water mark and stays there is not)\n",
+                     soak_flat(result) ? "no leak" : "LEAK", 100.0 * result.config.tolerance);
 }
 
 bool soak_flat(const SoakResult& result) noexcept {
   for (const SoakRun& r : result.runs)
-    if (!r.memory_flat || !r.pool_flat) return false;
+    if (!r.leak_free()) return false;
   return true;
 }
 
@@ -202,8 +230,9 @@ void write_soak_json(const SoakResult& result, std::ostream& out) {
                          {"heap_bytes", w.heap_bytes},
                          {"gl_queries", w.gl.queries}, {"gl_queries_free", w.gl.queries_free},
                          {"gl_buffers", w.gl.buffers}, {"gl_buffer_bytes", w.gl.buffer_bytes}});
-    runs.push_back({{"algorithm", r.algorithm}, {"memory_flat", r.memory_flat}, {"pool_flat", r.pool_flat},
-                    {"time_drift", r.time_drift}, {"windows", windows}});
+    runs.push_back({{"algorithm", r.algorithm}, {"memory", words(r.memory).name}, {"pool", words(r.pool).name},
+                    {"in_use", words(r.in_use).name}, {"buffers", words(r.buffers).name},
+                    {"leak_free", r.leak_free()}, {"time_drift", r.time_drift}, {"windows", windows}});
   }
   doc["runs"] = runs;
   out << doc.dump(2) << "\n";

@@ -51,9 +51,10 @@ std::vector<ObjectId> seen_only_through_depth_errors(const Scene& scene, const V
     const glm::dvec4 p = to_world * glm::dvec4(x, y, z, 1.0);
     return glm::dvec3(p) / p.w;
   };
-  // A depth value is read at its farthest within a few float units in the
-  // last place (read_depth's 1 - d under reversed-Z rounds near 1).
-  const double reading = std::ldexp(1.0, -21);
+  // A depth value is read at its farthest within 4 float units in the last
+  // place of a window depth near 1 (interpolation and storage round it;
+  // read_depth's 1 - d under reversed-Z rounds near 1 too).
+  const double reading = std::ldexp(1.0, -22);
   const auto magnitude = [](const glm::vec3& v) { return std::max({std::abs(v.x), std::abs(v.y), std::abs(v.z)}); };
   for (int y = 0; y < height; ++y)
     for (int x = 0; x < width; ++x) {
@@ -72,10 +73,18 @@ std::vector<ObjectId> seen_only_through_depth_errors(const Scene& scene, const V
       }
       const double nx = (x + 0.5) / width * 2.0 - 1.0, ny = (y + 0.5) / height * 2.0 - 1.0;
       const glm::dvec3 o = unproject(nx, ny, view.clip.near_depth());  // the ray on the near plane
-      const glm::dvec3 d = unproject(nx, ny, ndc_z) - o;               // ... to the pixel's depth: t = 1
+      const glm::dvec3 at = unproject(nx, ny, ndc_z);
+      const glm::dvec3 d = at - o;  // ... to the pixel's depth: t = 1
+      // The box grown by what a correct rasteriser may put between a surface
+      // and its pixel: its coordinates' float precision, and a 64th of a
+      // pixel at that depth (vertices snap to 1/256 px; a face seen at a
+      // grazing angle moves far along the ray when its outline moves a little).
+      const double pixel = std::max(glm::distance(unproject(nx + 2.0 / width, ny, ndc_z), at),
+                                    glm::distance(unproject(nx, ny + 2.0 / height, ndc_z), at));
       const Aabb& b = scene.object(id).bounds;
       const double slack =
-          std::ldexp(double(std::max({magnitude(b.min), magnitude(b.max), magnitude(view.eye)})), -16);
+          std::ldexp(double(std::max({magnitude(b.min), magnitude(b.max), magnitude(view.eye)})), -16) +
+          pixel / 64.0;
       double enter = 0.0, leave = std::numeric_limits<double>::infinity();
       for (int a = 0; a < 3; ++a) {
         const double lo = double(b.min[a]) - slack, hi = double(b.max[a]) + slack;
@@ -108,8 +117,8 @@ std::vector<FrameTruth> Session::ground_truth(const CameraPath& path, int frames
 }
 
 FrameTruth Session::truth_at(const CameraPath& path, int k, int frames) {
+  const View view = view_at(path, k, frames);  // the floating origin first: the scene's motions follow it
   advance_scene(frame_time(path, k, frames));
-  const View view = view_at(path, k, frames);
   const detail::FrameLabel where{scene_spec_, path.name(), k};
   if (bundle_.world) {
     bundle_.world->follow(bundle_.scene, view.eye);

@@ -81,7 +81,8 @@ layout(binding = 1) uniform sampler2D u_pyramid;  // mip k: level k + 1
 uniform int u_phase;       // 1 or 2
 uniform uint u_objects;    // objects in the scene; also the size of a command region
 uniform uint u_region;     // commands per region
-uniform mat4 u_view_proj;
+uniform mat4 u_view_proj;  // eye-relative (Impl::eye_relative)
+uniform vec3 u_eye;
 uniform vec4 u_planes[6];
 uniform vec2 u_viewport;   // pixels
 uniform int u_levels;
@@ -111,7 +112,7 @@ bool occluded(vec3 lo, vec3 hi) {
   float nearest = 1e30;
   for (int i = 0; i < 8; ++i) {
     vec3 c = vec3((i & 1) != 0 ? hi.x : lo.x, (i & 2) != 0 ? hi.y : lo.y, (i & 4) != 0 ? hi.z : lo.z);
-    vec4 h = u_view_proj * vec4(c, 1.0);
+    vec4 h = u_view_proj * vec4(c - u_eye, 1.0);
     if (h.w <= 0.0) return false;  // behind the eye
     float z = h.z / h.w;
     bool before_near = u_clip.y != 0 ? z > 1.0 : z < (u_clip.x != 0 ? 0.0 : -1.0);
@@ -218,6 +219,7 @@ void Renderer::Impl::create_device() {
   d.u_objects = cull_uniform("u_objects");
   d.u_region = cull_uniform("u_region");
   d.u_view_proj = cull_uniform("u_view_proj");
+  d.u_eye = cull_uniform("u_eye");
   d.u_planes = cull_uniform("u_planes");
   d.u_viewport = cull_uniform("u_viewport");
   d.u_levels = cull_uniform("u_levels");
@@ -333,7 +335,9 @@ void Renderer::Impl::start_device_frame() {
   const GLuint p = d.cull_program;
   glProgramUniform1ui(p, d.u_objects, GLuint(scene.objects().size()));
   glProgramUniform1ui(p, d.u_region, GLuint(std::max<std::size_t>(object_capacity, 1)));
-  glProgramUniformMatrix4fv(p, d.u_view_proj, 1, GL_FALSE, glm::value_ptr(view.view_proj));
+  const glm::mat4 relative = eye_relative(view);
+  glProgramUniformMatrix4fv(p, d.u_view_proj, 1, GL_FALSE, glm::value_ptr(relative));
+  glProgramUniform3fv(p, d.u_eye, 1, glm::value_ptr(view.eye));
   std::array<glm::vec4, 6> planes{};
   for (int k = 0; k < 6; ++k) planes[std::size_t(k)] = glm::vec4(view.frustum.plane(k).n, view.frustum.plane(k).d);
   glProgramUniform4fv(p, d.u_planes, 6, glm::value_ptr(planes[0]));
@@ -342,7 +346,7 @@ void Renderer::Impl::start_device_frame() {
   glProgramUniform2iv(p, d.u_level_size, GLsizei(d.level_size.size()), d.level_size[0].data());
   glProgramUniform2i(p, d.u_clip, clip.depth == DepthRange::zero_to_one ? 1 : 0, clip.reversed_z ? 1 : 0);
   glProgramUniform1i(p, d.u_compact, d.compact ? 1 : 0);
-  glProgramUniformMatrix4fv(d.draw_program, d.u_draw_view_proj, 1, GL_FALSE, glm::value_ptr(view.view_proj));
+  glProgramUniformMatrix4fv(d.draw_program, d.u_draw_view_proj, 1, GL_FALSE, glm::value_ptr(relative));
   glProgramUniform3fv(d.draw_program, d.u_draw_eye, 1, glm::value_ptr(view.eye));
   glProgramUniform3fv(d.draw_program, d.u_draw_background, 1, glm::value_ptr(options.background));
   glProgramUniform1f(d.draw_program, d.u_draw_fog, std::max(view.far, 1.0f));

@@ -65,7 +65,7 @@ struct DeviceState {
   bool timestamps = false;          // the device has GL_TIMESTAMP
   bool pyramid_built = false;       // build_depth_pyramid() ran this frame
   GLint u_phase = -1, u_objects = -1, u_region = -1, u_view_proj = -1, u_planes = -1, u_viewport = -1,
-        u_levels = -1, u_level_size = -1, u_clip = -1, u_compact = -1, u_texels = -1;
+        u_levels = -1, u_level_size = -1, u_clip = -1, u_compact = -1, u_texels = -1, u_eye = -1;
   GLint u_draw_view_proj = -1, u_draw_eye = -1, u_draw_background = -1, u_draw_fog = -1;
   GLint u_pyr_from_depth = -1, u_pyr_src_size = -1, u_pyr_dst_size = -1, u_pyr_reversed = -1;
 };
@@ -90,6 +90,17 @@ struct Renderer::Impl {
   GLenum conservative_cap = 0;                     // GL_CONSERVATIVE_RASTERIZATION_{NV,INTEL} when present
   GLsizei query_vertices = 36;                     // faces only, or faces and silhouette bands
   float query_slope_px = 0.0f;                     // polygon-offset slope factor of query boxes
+  // Every pass projects positions relative to the eye: its shaders take
+  // world - eye first (small numbers near the camera, whatever the
+  // coordinates' size) and then this matrix — the projection times the
+  // view's rotation, computed in double. Projecting world positions with
+  // view_proj directly rounds the depth of a surface 56 m away by 10-40
+  // float units at coordinates of 2 km (the large terms of z and w cancel,
+  // each rounded on its own), and query boxes then lose to the walls their
+  // objects stand a millimetre in front of.
+  [[nodiscard]] static glm::mat4 eye_relative(const View& v) {
+    return glm::mat4(glm::dmat4(v.proj) * glm::dmat4(glm::dmat3(glm::mat3(v.view))));
+  }
   // The clip conventions of the pass's view: depth range, and with reversed-Z
   // the depth tests, the depth clear and the polygon offset turn around.
   ClipSpace clip;

@@ -52,7 +52,8 @@ flat out uint v_object;
 #else
 uniform mat4 u_model;
 #endif
-uniform mat4 u_view_proj;
+uniform mat4 u_view_proj;  // eye-relative: projection times the view's rotation (Impl::eye_relative)
+uniform vec3 u_eye;
 out vec3 v_world;
 out vec3 v_normal;
 void main() {
@@ -70,7 +71,7 @@ void main() {
   vec4 world = m * vec4(a_position, 1.0);
   v_world = world.xyz;
   v_normal = mat3(m) * a_normal;
-  gl_Position = u_view_proj * world;
+  gl_Position = u_view_proj * vec4(world.xyz - u_eye, 1.0);
 }
 )";
 
@@ -144,7 +145,7 @@ layout(location = 1) in vec3 a_q;     // a band's second end
 layout(location = 2) in vec3 a_band;  // x: 1 on a band; y: 1 at the second end; z: side, -1 or +1
 layout(location = 3) in vec3 a_min;
 layout(location = 4) in vec3 a_max;
-uniform mat4 u_view_proj;
+uniform mat4 u_view_proj;      // eye-relative (Impl::eye_relative)
 uniform vec3 u_eye;
 uniform vec2 u_half_viewport;  // pixels
 uniform float u_margin;        // pixels
@@ -160,12 +161,12 @@ bool facing(int axis, bool hi, vec3 extent) {
 }
 
 void main() {
-  vec4 a = u_view_proj * vec4(mix(a_min, a_max, a_p), 1.0);
+  vec4 a = u_view_proj * vec4(mix(a_min, a_max, a_p) - u_eye, 1.0);
   if (a_band.x == 0.0) {
     gl_Position = a;
     return;
   }
-  vec4 b = u_view_proj * vec4(mix(a_min, a_max, a_q), 1.0);
+  vec4 b = u_view_proj * vec4(mix(a_min, a_max, a_q) - u_eye, 1.0);
   bool at_b = a_band.y > 0.5;
   int e = a_p.x != a_q.x ? 0 : (a_p.y != a_q.y ? 1 : 2);  // the edge's axis
   int f = (e + 1) % 3, g = (e + 2) % 3;                   // its two faces' axes

@@ -259,6 +259,13 @@ BenchResult run_osg_bench(const OsgBenchConfig& config, const ProgressFn& progre
   if (const int fit = path.frames_that_fit(config.sampling); config.frames > fit)
     throw InputError(fmt::format("--frames {} runs past the end of path {}: {} frames fit", config.frames,
                                  path.name(), fit));
+  // The OSG graph is made once from the scene as it stands: the session's
+  // floating origin must not move during the walk (it re-places occull's objects only).
+  for (int k = 0; k < config.frames; ++k)
+    if (session.origin_for(path.sample(session.frame_time(path, k, config.frames))) != session.origin())
+      throw InputError(fmt::format("{}: path {} crosses from one floating-origin cell of {:g} m to another (frame {}); "
+                                   "OSG's graph does not follow a moved origin: run occull bench there",
+                                   config.scene, path.name(), session.origin_grid(), k));
   const auto say = [&](const std::string& line) {
     if (progress) progress(line, 0, 0, false);
   };

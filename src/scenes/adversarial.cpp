@@ -17,7 +17,12 @@
 //             under, boxes it goes through, a low ceiling;
 //   far       objects of about one pixel 0.8-3 km away, flat strips among
 //             them, seen across the ground and through the slits;
-//   mixed     all of the above (the default).
+//   farout    zero-thickness panels with objects of 1-5 cm hidden a hand's
+//             width behind them and peeking a few millimetres past their
+//             edges, and the whole stage, its paths too, 3 km out from the
+//             scene's own origin: float precision at work (with the scene's
+//             `offset`, kilometres to thousands of them from the world's);
+//   mixed     all of the above but farout (the default).
 // Paths: `walk` at eye height through the near objects, `graze` 0.4 m above
 // the ground looking along it, `far` along the stage's edge turning full
 // circle.
@@ -32,8 +37,10 @@
 namespace occull::scenes {
 namespace {
 
-enum Kind { mixed, tiny, thin, coplanar, near, far, kind_count };
-const char* const kKindNames[] = {"mixed", "tiny", "thin", "coplanar", "near", "far"};
+enum Kind { mixed, tiny, thin, coplanar, near, far, farout, kind_count };
+const char* const kKindNames[] = {"mixed", "tiny", "thin", "coplanar", "near", "far", "farout"};
+
+constexpr float kFarOut = 3000.0f;  // farout: the stage's distance from the scene's origin along x and z, metres
 
 constexpr float kStage = 300.0f;   // side of the square stage, metres
 constexpr float kEye = 1.6f;
@@ -54,9 +61,10 @@ struct Stage {
   };
   std::vector<Wall> walls;
   std::vector<glm::vec3> walk;  // eye positions of the walk path's keys
+  glm::vec3 out{0.0f};          // where the stage stands in the scene (farout: far from its origin)
 
   ObjectId add(Mesh mesh, MaterialId material, OccluderClass cls, const glm::mat4& t = glm::mat4(1.0f)) {
-    return scene.add_object(scene.add_mesh(std::move(mesh)), material, t, cls);
+    return scene.add_object(scene.add_mesh(std::move(mesh)), material, glm::translate(glm::mat4(1.0f), out) * t, cls);
   }
   glm::vec2 random_spot(float margin = 0.0f) {
     const float h = 0.5f * kStage - margin;
@@ -319,6 +327,35 @@ void build_far(Stage& s, int count) {
   }
 }
 
+// Thin occluders and tiny objects: a zero-thickness panel (one-sided,
+// facing +Z before its yaw) with objects of 1-5 cm a few centimetres to a
+// hand's width behind it, peeking past its side edges by millimetres, and
+// lying on its top edge.
+void build_farout(Stage& s, int count) {
+  for (int made = 0; made < count;) {
+    const glm::vec2 c = s.random_spot(10.0f);
+    const float w = s.rng.uniform(1.0f, 4.0f), h = s.rng.uniform(0.8f, 3.0f);
+    const float yaw = s.rng.chance(0.5f) ? glm::half_pi<float>() * float(s.rng.integer(0, 3))
+                                         : s.rng.uniform(0.0f, glm::two_pi<float>());
+    const glm::mat4 at = placed({c.x, 0.0f, c.y}, yaw);
+    s.add(panel(w, h), s.m.wall, OccluderClass::always, at);
+    ++made;
+    for (int k = 0; k < 8 && made < count; ++k, ++made) {
+      const float size = s.rng.uniform(0.01f, 0.05f);
+      const float where = s.rng.uniform();
+      glm::vec3 local;
+      if (where < 0.5f)  // behind it
+        local = {s.rng.uniform(-0.45f, 0.45f) * w, s.rng.uniform(0.0f, h - size), -s.rng.uniform(0.02f, 0.3f)};
+      else if (where < 0.85f)  // behind a side edge, peeking past it by 0.5-3 mm
+        local = {(s.rng.chance(0.5f) ? 1.0f : -1.0f) * (0.5f * w + s.rng.uniform(0.0005f, 0.003f) - 0.5f * size),
+                 s.rng.uniform(0.0f, h - size), -s.rng.uniform(0.01f, 0.1f)};
+      else  // on its top edge, just behind it
+        local = {s.rng.uniform(-0.45f, 0.45f) * w, h, -0.5f * size - 0.001f};
+      s.add(small_mesh(s.rng, size), s.m.prop, OccluderClass::never, at * placed(local, s.rng.uniform(0.0f, 6.3f)));
+    }
+  }
+}
+
 CameraPath::Key key_at(double t, glm::vec3 eye, float yaw, float pitch = 0.0f) {
   return {t, {eye, yaw, pitch}, false};
 }
@@ -331,7 +368,8 @@ float yaw_towards(glm::vec3 a, glm::vec3 b) { return std::atan2(-(b.x - a.x), -(
 SceneInfo adversarial_info() {
   SceneInfo info{"adversarial",
                  "scenes built to make conservative culling miss: tiny meshes, zero-thickness boxes, "
-                 "coplanar and touching objects, the camera through boxes, one-pixel objects kilometres away",
+                 "coplanar and touching objects, the camera through boxes, one-pixel objects kilometres away, "
+                 "thin panels hiding centimetre objects kilometres from the origin",
                  {{"kind", 0, 0, double(kind_count - 1), true, "which attack (see README)", {}},
                   {"objects", 3000, 10, 100000, true, "objects of the attack, besides the stage"},
                   {"seed", 1, 0, 1e9, true, "random seed"}},
@@ -356,6 +394,7 @@ SceneBundle make_adversarial(const Params& params) {
           {},
           {}};
 
+  if (kind == farout) s.out = glm::vec3(kFarOut, 0.0f, kFarOut);
   // The walk path first: the near objects are placed along it.
   const float h = 0.5f * kStage;
   for (int k = 0; k <= 10; ++k) {
@@ -364,12 +403,13 @@ SceneBundle make_adversarial(const Params& params) {
   }
   build_ground(s);
   build_walls(s);
-  const auto share = [&](Kind k) { return kind == k ? count : (kind == mixed ? count / 5 : 0); };
+  const auto share = [&](Kind k) { return kind == k ? count : (kind == mixed && k != farout ? count / 5 : 0); };
   build_tiny(s, share(tiny));
   build_thin(s, share(thin));
   build_coplanar(s, share(coplanar));
   build_near(s, share(near));
   build_far(s, share(far));
+  build_farout(s, share(farout));
 
   {
     std::vector<CameraPath::Key> keys;
@@ -403,6 +443,12 @@ SceneBundle make_adversarial(const Params& params) {
                               "one-pixel objects kilometres away",
                               std::move(keys));
   }
+  if (s.out != glm::vec3(0.0f))  // the paths stand where the stage does
+    for (CameraPath& p : bundle.paths) {
+      std::vector<CameraPath::Key> keys = p.keys();
+      for (CameraPath::Key& k : keys) k.pose.position += s.out;
+      p = CameraPath(p.name(), p.description(), std::move(keys));
+    }
   return bundle;
 }
 

@@ -18,12 +18,24 @@ struct Generator {
   SceneBundle (*make)(const scenes::Params&);
 };
 
+// Where a scene stands in the world: a parameter of every scene that is not
+// a tiled world (those place their own tiles around the eye, 10 km and more
+// from their origin already). make_scene applies it (SceneBundle::origin).
+constexpr double kMaxOffset = 1e7;  // metres: 10,000 km
+SceneInfo with_offset(SceneInfo info) {
+  info.params.push_back({"offset", 0.0, -kMaxOffset, kMaxOffset, false,
+                         "the scene and its paths placed this many metres along x and along z from the world's "
+                         "origin (far from it, occull works relative to a floating origin near the camera: "
+                         "docs/library.md)"});
+  return info;
+}
+
 const std::vector<Generator>& generators() {
   static const std::vector<Generator> all = {
-      {scenes::city_info(), &scenes::make_city},
-      {scenes::field_info(), &scenes::make_field},
-      {scenes::track_info(), &scenes::make_track},
-      {scenes::adversarial_info(), &scenes::make_adversarial},
+      {with_offset(scenes::city_info()), &scenes::make_city},
+      {with_offset(scenes::field_info()), &scenes::make_field},
+      {with_offset(scenes::track_info()), &scenes::make_track},
+      {with_offset(scenes::adversarial_info()), &scenes::make_adversarial},
       {scenes::tiles_city_info(), &scenes::make_tiles_city},
       {scenes::tiles_forest_info(), &scenes::make_tiles_forest},
       {scenes::tiles_hybrid_info(), &scenes::make_tiles_hybrid},
@@ -133,7 +145,10 @@ SceneBundle make_scene(std::string_view spec) {
   if (spec.rfind("q3:", 0) == 0) return q3::load(spec.substr(3));
   if (spec.rfind("file:", 0) == 0) return scenes::load_model_file(std::string(spec.substr(5)));
   const scenes::ParsedSpec parsed = scenes::parse_spec(spec);
-  return parsed.make(parsed.params);
+  SceneBundle bundle = parsed.make(parsed.params);
+  if (const auto offset = parsed.params.find("offset"); offset != parsed.params.end())
+    bundle.origin = glm::dvec3(offset->second, 0.0, offset->second);
+  return bundle;
 }
 
 }  // namespace occull
