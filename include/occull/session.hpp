@@ -80,9 +80,8 @@ inline constexpr double kDepthErrorTolerance = 1e-4;
 /// float precision, and a 64th of a pixel at that depth for vertex
 /// snapping). No surface of the object lies there: the rasteriser put it
 /// there. Mesa's llvmpipe does, in its early depth test, for sub-pixel
-/// sliver triangles (a terrain seen edge-on far away, a pole's foot seen
-/// from 0.4 m above the ground): it extrapolates their depth outside their
-/// vertices' range, so a tile 528 m away shows one pixel at 206 m, through
+/// sliver triangles (a terrain seen edge-on far away): it extrapolates
+/// their depth outside their vertices' range, so a tile 528 m away shows one pixel at 206 m, through
 /// a rock at 417 m (docs/instrument.md, "Depth errors of the rasteriser").
 /// A pixel whose ray misses the box (snapping widened the outline) or
 /// starts inside it counts as the object's own. Ascending ids.
