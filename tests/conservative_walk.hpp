@@ -56,7 +56,6 @@ inline WalkBaseline walk_baseline(Session& session, const CameraPath& path, int 
 /// Numbers in docs/instrument.md, "Culling, not only conservative".
 inline double culling_bound(std::string_view spec) {
   const std::string_view name = spec.substr(0, spec.find(':'));
-  if (spec.find("local=none") != std::string_view::npos) return 1e9;  // tiles drawn whole, by design
   if (name == "stopwait" || name == "chc") return 0.6;  // measured up to 0.43
   if (name == "chcpp") return 0.95;                      // measured up to 0.91 (tight=off, city)
   if (name == "hiz") return 0.93;                        // measured up to 0.87 (adversarial)

@@ -927,7 +927,7 @@ constexpr std::pair<int, const char*> kExitCodes[] = {
     {2, "bad input: unknown scene / path / algorithm / option (the message lists the valid ones), invalid number or size, a damaged level, model, path or profile file (the message names the file and the fault), an output file or folder that cannot be written"},
     {3, "no usable OpenGL 4.5: EGL or the driver is missing (the message says which package); `view`: no display, or built without its viewer"},
     {4, "`bench`, `osg`: verification failed — a conservative algorithm culled a visible object (the table, JSON and report are written first)"},
-    {5, "`soak`: a leak — resident memory, the query pool, the queries held at a window's end or the buffers more than 5 % above the first window and still growing over the last windows (a high-water mark reached is not one; the table and JSON are written first)"},
+    {5, "`soak`: a leak — a figure more than 5 % above its first window and still growing (the table and JSON are written first)"},
 };
 
 std::string exit_code_table() {

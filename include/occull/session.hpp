@@ -389,8 +389,9 @@ class Session {
   std::uint64_t origin_moves_ = 0;
   std::vector<glm::mat4> home_;
   std::vector<Motion> home_motions_;
-  // `home` (relative to bundle_.origin) relative to origin_, in double.
+  // `home` (a transform or a point relative to bundle_.origin) relative to origin_, in double.
   [[nodiscard]] glm::mat4 placed(const glm::mat4& home) const;
+  [[nodiscard]] glm::vec3 placed(const glm::vec3& home) const;
   // Moves the scene's frame to `origin` (world), re-placing every object and motion.
   void move_origin(const glm::dvec3& origin);
   // The scene at path time `time_s`: Motions, then the engine's moves.

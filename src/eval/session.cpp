@@ -150,7 +150,7 @@ glm::dvec3 Session::origin_for(const CameraPose& pose) const {
 View Session::view_of(CameraPose pose) {
   if (!bundle_.world) {
     move_origin(origin_for(pose));
-    pose.position = glm::vec3(bundle_.origin + glm::dvec3(pose.position) - origin_);
+    pose.position = placed(pose.position);
   }
   return make_view(pose, bundle_.lens, renderer_->width(), renderer_->height());
 }
@@ -167,6 +167,8 @@ glm::mat4 Session::placed(const glm::mat4& home) const {
   return glm::mat4(m);
 }
 
+glm::vec3 Session::placed(const glm::vec3& home) const { return glm::vec3(glm::dvec3(home) + bundle_.origin - origin_); }
+
 void Session::move_origin(const glm::dvec3& origin) {
   if (origin == origin_) return;
   origin_ = origin;
@@ -174,10 +176,9 @@ void Session::move_origin(const glm::dvec3& origin) {
   Scene& scene = bundle_.scene;
   for (ObjectId id = 0; id < home_.size(); ++id)
     if (scene.alive(id) && !scene.object(id).dynamic()) scene.set_transform(id, placed(home_[id]));
-  const glm::dvec3 shift = bundle_.origin - origin_;
   for (std::size_t i = 0; i < home_motions_.size(); ++i) {
     Motion m = home_motions_[i];
-    for (glm::vec3& p : m.waypoints) p = glm::vec3(glm::dvec3(p) + shift);
+    for (glm::vec3& p : m.waypoints) p = placed(p);
     scene.set_motion(i, std::move(m));
   }
 }

@@ -240,9 +240,9 @@ void Renderer::Impl::prepare_pass(const View& v) {
                                        scene.objects().size(), scene.objects().size() - object_capacity));
   establish_frame_state();
   upload_dynamic_transforms();
-  const glm::mat4 relative = eye_relative(view);
-  glProgramUniformMatrix4fv(scene_program, u_scene_view_proj, 1, GL_FALSE, glm::value_ptr(relative));
-  glProgramUniformMatrix4fv(query_program, u_query_view_proj, 1, GL_FALSE, glm::value_ptr(relative));
+  view_proj_relative = eye_relative(view);
+  glProgramUniformMatrix4fv(scene_program, u_scene_view_proj, 1, GL_FALSE, glm::value_ptr(view_proj_relative));
+  glProgramUniformMatrix4fv(query_program, u_query_view_proj, 1, GL_FALSE, glm::value_ptr(view_proj_relative));
   glProgramUniform3fv(query_program, u_query_eye, 1, glm::value_ptr(view.eye));
   glProgramUniform3fv(scene_program, u_eye, 1, glm::value_ptr(view.eye));
   glProgramUniform3fv(scene_program, u_background, 1, glm::value_ptr(options.background));

@@ -335,8 +335,7 @@ void Renderer::Impl::start_device_frame() {
   const GLuint p = d.cull_program;
   glProgramUniform1ui(p, d.u_objects, GLuint(scene.objects().size()));
   glProgramUniform1ui(p, d.u_region, GLuint(std::max<std::size_t>(object_capacity, 1)));
-  const glm::mat4 relative = eye_relative(view);
-  glProgramUniformMatrix4fv(p, d.u_view_proj, 1, GL_FALSE, glm::value_ptr(relative));
+  glProgramUniformMatrix4fv(p, d.u_view_proj, 1, GL_FALSE, glm::value_ptr(view_proj_relative));
   glProgramUniform3fv(p, d.u_eye, 1, glm::value_ptr(view.eye));
   std::array<glm::vec4, 6> planes{};
   for (int k = 0; k < 6; ++k) planes[std::size_t(k)] = glm::vec4(view.frustum.plane(k).n, view.frustum.plane(k).d);
@@ -346,7 +345,7 @@ void Renderer::Impl::start_device_frame() {
   glProgramUniform2iv(p, d.u_level_size, GLsizei(d.level_size.size()), d.level_size[0].data());
   glProgramUniform2i(p, d.u_clip, clip.depth == DepthRange::zero_to_one ? 1 : 0, clip.reversed_z ? 1 : 0);
   glProgramUniform1i(p, d.u_compact, d.compact ? 1 : 0);
-  glProgramUniformMatrix4fv(d.draw_program, d.u_draw_view_proj, 1, GL_FALSE, glm::value_ptr(relative));
+  glProgramUniformMatrix4fv(d.draw_program, d.u_draw_view_proj, 1, GL_FALSE, glm::value_ptr(view_proj_relative));
   glProgramUniform3fv(d.draw_program, d.u_draw_eye, 1, glm::value_ptr(view.eye));
   glProgramUniform3fv(d.draw_program, d.u_draw_background, 1, glm::value_ptr(options.background));
   glProgramUniform1f(d.draw_program, d.u_draw_fog, std::max(view.far, 1.0f));

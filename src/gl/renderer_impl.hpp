@@ -101,6 +101,7 @@ struct Renderer::Impl {
   [[nodiscard]] static glm::mat4 eye_relative(const View& v) {
     return glm::mat4(glm::dmat4(v.proj) * glm::dmat4(glm::dmat3(glm::mat3(v.view))));
   }
+  glm::mat4 view_proj_relative{1.0f};  // eye_relative(view) of the current pass (prepare_pass)
   // The clip conventions of the pass's view: depth range, and with reversed-Z
   // the depth tests, the depth clear and the polygon offset turn around.
   ClipSpace clip;
