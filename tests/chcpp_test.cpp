@@ -24,7 +24,7 @@ Scene row_scene(int n) {
   return test::box_scene(boxes);
 }
 
-const View kView = make_view({{0, 0, 0}, 0, 0}, {60.0f, 0.1f, 500.0f}, 64, 64);
+const View kView = test::unsampled(make_view({{0, 0, 0}, 0, 0}, {60.0f, 0.1f, 500.0f}, 64, 64));
 
 // Visible = overlaps one of the given boxes.
 std::function<std::uint64_t(std::span<const Aabb>)> visible_if_overlapping(std::vector<Aabb>* visible) {
@@ -86,7 +86,7 @@ TEST(Chcpp, NodesThatStayInvisibleShareMultiqueriesAndAFailedOneIsSplit) {
     if (!hidden(i)) visible.push_back(boxes[i]);
   test::ScriptedBackend backend;
   backend.visible_samples = visible_if_overlapping(&visible);
-  const View view = make_view({{0, 0, 0}, 0, 0}, {90.0f, 0.1f, 500.0f}, 64, 64);
+  const View view = test::unsampled(make_view({{0, 0, 0}, 0, 0}, {90.0f, 0.1f, 500.0f}, 64, 64));
   std::uint64_t multiqueries = 0;
   for (int f = 0; f < 20; ++f) multiqueries += culler->render_frame(view, backend).multiqueries;
   EXPECT_GT(multiqueries, 0u) << "persistently invisible nodes are grouped";
@@ -166,7 +166,7 @@ TEST(Jitter, NewlyVisibleLeavesAreNotReQueriedAllInOneFrame) {
     visible.clear();
     test::ScriptedBackend backend;
     backend.visible_samples = visible_if_overlapping(&visible);
-    const View view = make_view({{0, 0, 0}, 0, 0}, {90.0f, 0.1f, 500.0f}, 64, 64);
+    const View view = test::unsampled(make_view({{0, 0, 0}, 0, 0}, {90.0f, 0.1f, 500.0f}, 64, 64));
     culler->render_frame(view, backend);  // frame 1: nothing visible
     visible = boxes;
     culler->render_frame(view, backend);  // frame 2: everything turns visible
@@ -326,7 +326,7 @@ std::uint64_t queries_while_turning(const char* enter_p_min, bool all_visible) {
   if (!all_visible) backend.visible_samples = [](std::span<const Aabb>) { return std::uint64_t(0); };
   std::uint64_t queries = 0;
   for (int f = 0; f < 120; ++f) {
-    const View view = make_view({{0, 0, 0}, 0.15f * float(f), 0}, {60.0f, 0.1f, 100.0f}, 64, 64);
+    const View view = test::unsampled(make_view({{0, 0, 0}, 0.15f * float(f), 0}, {60.0f, 0.1f, 100.0f}, 64, 64));
     backend.rendered.clear();
     const std::uint64_t before = backend.stats().queries;
     (void)culler->render_frame(view, backend);

@@ -32,7 +32,7 @@ std::vector<Aabb> scattered_boxes(int n) {
 
 TEST(EngineDrivenScene, EveryAlgorithmFollowsMovesAdditionsAndRemovals) {
   const test::ProfileFile profile("occull-engine-" + std::to_string(::getpid()) + ".json");
-  const View view = make_view({{0, 0, 0}, 0, 0}, {70.0f, 0.1f, 500.0f}, 64, 64);
+  const View view = test::unsampled(make_view({{0, 0, 0}, 0, 0}, {70.0f, 0.1f, 500.0f}, 64, 64));
   std::size_t rebuilds = 0, removed_seen = 0;
   for (const AlgorithmInfo& info : algorithms()) {
     if (info.harness_only || !runs_on(info, false)) continue;
@@ -126,7 +126,7 @@ TEST(EngineDrivenScene, HierarchicalCullersKeepTheirStateAcrossARebuild) {
   const HardwareProfile profile = test::hardware_profile();
   CullerContext context;
   context.nohc_profile = &profile;
-  const View view = make_view({{0, 0, 0}, 0, 0}, {70.0f, 0.1f, 500.0f}, 64, 64);
+  const View view = test::unsampled(make_view({{0, 0, 0}, 0, 0}, {70.0f, 0.1f, 500.0f}, 64, 64));
   for (const char* name : {"chc", "chcpp", "nohc"}) {
     SCOPED_TRACE(name);
     std::size_t less = 0;

@@ -145,3 +145,30 @@ TEST(Invariants, CpuProbeFindsTrianglesToTestOnAPlainView) {
   const detail::FrameLabel where{"boxes", "none", 0};
   EXPECT_EQ(detail::check_truth_probes(where, scene, view, all, images.depth, true), 2u);
 }
+
+TEST(Invariants, SubpixelRuleCullingAVisibleObjectStopsTheRun) {
+  // A box a fifth of a pixel across over a pixel centre is in the truth; a
+  // box a pixel across lying between centres is not. The sub-pixel rule
+  // keeps the first (the invariant holds and counts the second); a size
+  // threshold in its place would cull a visible object, and the invariant
+  // says so.
+  auto context = gl::Context::create();
+  const Scene scene = test::box_scene({{{-7.2f, -7.2f, -10.01f}, {-6.8f, -6.8f, -10.0f}},
+                                       {{-4.9f, -4.9f, -10.01f}, {-3.1f, -3.1f, -10.0f}}});
+  gl::Renderer r(scene, test::small_target(10, 10));
+  const View view = make_view({{0, 0, 0}, 0, 0}, {90.0f, 0.1f, 100.0f}, 10, 10);
+  const ObjectId all[] = {0, 1};
+  const auto visible = r.visible_pixels(view, all);
+  ASSERT_EQ(visible.size(), 1u);
+  EXPECT_EQ(visible[0].id, 0u);
+  const detail::FrameLabel where{"boxes", "none", 0};
+  EXPECT_EQ(detail::check_truth_holds_samples(where, visible, scene, view), 1u);
+  SubpixelRules size_threshold;
+  size_threshold.pixel_centres = false;
+  try {
+    (void)detail::check_truth_holds_samples(where, visible, scene, view, size_threshold);
+    ADD_FAILURE() << "a size threshold culling a visible object passed the invariant";
+  } catch (const InvariantViolation& e) {
+    EXPECT_NE(std::string(e.what()).find("truth-holds-samples"), std::string::npos) << e.what();
+  }
+}

@@ -20,7 +20,7 @@ using namespace occull;
 namespace {
 
 constexpr Lens kLens{60.0f, 0.1f, 500.0f};
-const View kView = make_view({{0, 0, 0}, 0, 0}, kLens, 64, 64);
+const View kView = test::unsampled(make_view({{0, 0, 0}, 0, 0}, kLens, 64, 64));
 
 std::string error_of(const CameraPose& pose, const Lens& lens, int w, int h) {
   try {

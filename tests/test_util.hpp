@@ -51,6 +51,14 @@ class ProfileFile {
 };
 
 /// A closed box mesh (12 triangles) spanning b, outward CCW faces.
+/// A view whose "truth" is a test double's geometry rather than an image
+/// sampled at pixel centres: no exact sub-pixel culling (View::samples = 0),
+/// so every object in the frustum counts.
+inline View unsampled(View view) {
+  view.samples = 0;
+  return view;
+}
+
 inline Mesh box_mesh(const Aabb& b) {
   Mesh m;
   const glm::vec3 n[6] = {{-1, 0, 0}, {1, 0, 0}, {0, -1, 0}, {0, 1, 0}, {0, 0, -1}, {0, 0, 1}};

@@ -172,3 +172,67 @@ TEST(ViewFromMatrices, BadMatricesAreRefusedNamingTheValue) {
   refused(kCamera, tilted, "neither perspective");
   refused(kCamera, gl_standard(), "viewport", 0, 64);
 }
+
+// Exact sub-pixel culling (holds_no_sample): a 10 × 10 viewport, 90 degrees,
+// looking down -Z from the origin. At a distance of 10 a pixel is 2 units
+// and pixel centres lie at odd coordinates (-9, -7, ..., 9).
+namespace {
+View ten_by_ten(glm::vec3 eye = glm::vec3(0.0f)) { return make_view({eye, 0, 0}, {90.0f, 0.1f, 100.0f}, 10, 10); }
+Aabb flat_box(float x0, float x1, float y0, float y1, glm::vec3 eye = glm::vec3(0.0f)) {
+  return {eye + glm::vec3(x0, y0, -10.0f), eye + glm::vec3(x1, y1, -10.0f)};
+}
+}  // namespace
+
+TEST(Subpixel, ABoxBetweenPixelCentresHoldsNoSample) {
+  EXPECT_TRUE(holds_no_sample(flat_box(-8.9f, -7.1f, -8.9f, -7.1f), ten_by_ten()));
+  // Between centres on one axis only is enough.
+  EXPECT_TRUE(holds_no_sample(flat_box(-8.9f, -7.1f, -9.5f, 9.5f), ten_by_ten()));
+  EXPECT_FALSE(holds_no_sample(flat_box(-9.5f, 9.5f, -9.5f, 9.5f), ten_by_ten()));
+}
+
+TEST(Subpixel, ABoxSmallerThanAPixelOverACentreHoldsOne) {
+  // A fifth of a pixel across, over the centre (-7, -7): it makes a fragment.
+  const Aabb box = flat_box(-7.2f, -6.8f, -7.2f, -6.8f);
+  EXPECT_FALSE(holds_no_sample(box, ten_by_ten()));
+  // A size threshold (engines' small-feature culling) culls it: it pops.
+  SubpixelRules size_threshold;
+  size_threshold.pixel_centres = false;
+  EXPECT_TRUE(holds_no_sample(box, ten_by_ten(), size_threshold));
+}
+
+TEST(Subpixel, AnEdgeWithinTheSnappingMarginOfACentreKeepsTheBox) {
+  // Ends 1/128 pixel before the centre at -7: snapping may move it across.
+  const float before = -7.0f - 2.0f / 128.0f;
+  const Aabb box = flat_box(-8.9f, before, -8.9f, -7.1f + 2.0f);
+  EXPECT_FALSE(holds_no_sample(box, ten_by_ten()));
+  SubpixelRules no_margin;
+  no_margin.snapping_margin = false;
+  EXPECT_TRUE(holds_no_sample(box, ten_by_ten(), no_margin));
+  // A centre exactly on the edge is inside (ties keep the box).
+  EXPECT_FALSE(holds_no_sample(flat_box(-8.9f, -7.0f, -8.9f, -5.0f), ten_by_ten(), no_margin));
+}
+
+TEST(Subpixel, FarFromTheOriginTheBoxIsGrownForFloatRounding) {
+  // At 1e6 a float holds 1/16 of a unit: the device's vertices may lie that
+  // far outside their box. 2^-20 of 1e6 (0.95 units, half a pixel here)
+  // keeps a box ending 0.3 pixel before a centre.
+  const glm::vec3 eye(1.0e6f, 0.0f, 0.0f);
+  const Aabb box = flat_box(-8.9f, -7.6f, -8.9f, -5.0f, eye);
+  EXPECT_FALSE(holds_no_sample(box, ten_by_ten(eye)));
+  SubpixelRules exact;
+  exact.grow_for_rounding = false;
+  EXPECT_TRUE(holds_no_sample(box, ten_by_ten(eye), exact));
+}
+
+TEST(Subpixel, ABoxReachingTheNearPlaneOrTheEyeIsKept) {
+  const View view = ten_by_ten();
+  EXPECT_FALSE(holds_no_sample({{0.01f, 0.01f, -10.0f}, {0.02f, 0.02f, 0.05f}}, view));  // through the near plane
+  EXPECT_FALSE(holds_no_sample({{0.01f, 0.01f, 1.0f}, {0.02f, 0.02f, 2.0f}}, view));     // behind the eye
+}
+
+TEST(Subpixel, OnlyASingleSampledViewSkipsAnything) {
+  View view = ten_by_ten();
+  view.samples = 0;  // MSAA, or rendered at another size
+  EXPECT_FALSE(holds_no_sample(flat_box(-8.9f, -7.1f, -8.9f, -7.1f), view));
+  EXPECT_FALSE(holds_no_sample(Aabb{}, ten_by_ten()));  // empty
+}

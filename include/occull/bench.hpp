@@ -79,6 +79,7 @@ struct AlgorithmSummary {
   double stalled_per_frame = 0.0;  ///< query results given up on by --stall-guard (FrameStats::stalled)
   double nodes_visited_per_frame = 0.0;
   double extra_objects_per_frame = 0.0;  ///< over-rendering (verified runs)
+  double subpixel_objects_per_frame = 0.0;  ///< objects of the frustum holding no pixel centre (FrameStats::subpixel_objects)
   double wait_ms_per_frame = 0.0;
   double blocking_waits_per_frame = 0.0;  ///< query reads that had to wait (sync points)
   double flushes_per_frame = 0.0;         ///< submissions to the device mid-frame (BackendStats::flushes)

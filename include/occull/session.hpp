@@ -61,6 +61,9 @@ struct FrameTruth {
   /// rasteriser's depth errors (seen_only_through_depth_errors), ascending:
   /// leaving one out is not a miss. Usually empty.
   std::vector<ObjectId> depth_error_only;
+  /// Objects of the frustum whose boxes hold no sample (holds_no_sample):
+  /// none of them is in `visible` (invariant truth-holds-samples).
+  std::uint32_t subpixel = 0;
 };
 
 /// The share of the distance from the eye by which a pixel's depth may lie

@@ -84,6 +84,11 @@ struct FrameStats {
   /// rasteriser's depth errors (fragments nearer than the object's own box):
   /// not missed (Session::verify_frame).
   std::uint32_t depth_error_objects = 0;
+  /// Objects in the frustum whose boxes hold no pixel centre
+  /// (holds_no_sample, occull/view.hpp): they make no fragment, and every
+  /// culler but vfc skips them (exact sub-pixel culling). A property of the
+  /// view, counted by the verifier.
+  std::uint32_t subpixel_objects = 0;
 };
 
 }  // namespace occull

@@ -34,7 +34,40 @@ struct View {
   /// rectangle, scene units: a box farther than this from the eye cannot be
   /// cut by the near plane.
   float near_radius = 0.0f;
+  /// How the image is sampled: 1, one sample at the centre of each of the
+  /// width × height pixels (a single-sampled target of exactly that size,
+  /// the default); 0, anything else or unknown (MSAA, sample shading, a
+  /// render size other than width × height). Only with 1 may cullers skip a
+  /// box that holds no pixel centre (holds_no_sample): drawn, it would make
+  /// no fragment.
+  int samples = 1;
 };
+
+/// Exact sub-pixel culling: whether whatever lies in `box` (world space)
+/// makes no fragment in `view`, because the rectangle its 8 corners project
+/// to holds no pixel centre of the viewport. Lossless, unlike a size
+/// threshold: a box smaller than a pixel that straddles a centre is kept.
+/// Conservative by these rules (each with its test in tests/view_test.cpp,
+/// SubpixelRules switching it off):
+///  1. Only for view.samples == 1 (one sample at each pixel's centre).
+///  2. The box is grown by 2^-20 of its coordinates' magnitude first: the
+///     device transforms vertices in float, which can put a vertex a few
+///     units in the last place outside the box it was bounded by.
+///  3. Corners are projected relative to the eye in double, as the
+///     renderer projects (occull/gl: world - eye, then projection times the
+///     view's rotation); the rectangle is widened by 1/64 pixel on every side
+///     for the device's vertex snapping (1/256 pixel on llvmpipe and current
+///     GPUs) and its float projection.
+///  4. A box with a corner behind the eye or in front of the near plane is
+///     kept (its rectangle means nothing).
+///  5. A centre on the rectangle's edge is inside (ties keep the box).
+/// Returns false ("may make a fragment") for an empty box too.
+struct SubpixelRules {
+  bool grow_for_rounding = true;  ///< rule 2
+  bool snapping_margin = true;    ///< rule 3's widening
+  bool pixel_centres = true;      ///< false: a size threshold instead (the rectangle narrower than a pixel), as engines' small-feature culling does
+};
+[[nodiscard]] bool holds_no_sample(const Aabb& box, const View& view, const SubpixelRules& rules = {}) noexcept;
 
 /// How make_view() builds a lens's projection.
 enum class DepthMode : std::uint8_t {

@@ -31,6 +31,44 @@ std::string depth_name(const ClipSpace& clip) {
 
 }  // namespace
 
+bool holds_no_sample(const Aabb& box, const View& view, const SubpixelRules& rules) noexcept {
+  if (view.samples != 1 || box.empty()) return false;  // rule 1
+  glm::dvec3 lo(box.min), hi(box.max);
+  if (rules.grow_for_rounding) {  // rule 2
+    double magnitude = 0.0;
+    for (int a = 0; a < 3; ++a) magnitude = std::max({magnitude, std::abs(lo[a]), std::abs(hi[a])});
+    const double grow = std::ldexp(magnitude, -20);
+    lo -= grow;
+    hi += grow;
+  }
+  // Rule 3: eye-relative, in double.
+  const glm::dmat4 m = glm::dmat4(view.proj) * glm::dmat4(glm::dmat3(glm::mat3(view.view)));
+  const glm::dvec3 eye(view.eye);
+  const double near_depth = double(view.clip.near_depth());
+  double min_x = std::numeric_limits<double>::infinity(), max_x = -min_x, min_y = min_x, max_y = -min_x;
+  for (int k = 0; k < 8; ++k) {
+    const glm::dvec3 p((k & 1) ? hi.x : lo.x, (k & 2) ? hi.y : lo.y, (k & 4) ? hi.z : lo.z);
+    const glm::dvec4 c = m * glm::dvec4(p - eye, 1.0);
+    // Rule 4: every corner beyond the near plane.
+    const bool beyond_near = view.clip.reversed_z ? c.z < c.w : c.z > near_depth * c.w;
+    if (!(c.w > 0.0) || !beyond_near) return false;
+    const double x = (c.x / c.w * 0.5 + 0.5) * double(view.width), y = (c.y / c.w * 0.5 + 0.5) * double(view.height);
+    min_x = std::min(min_x, x), max_x = std::max(max_x, x);
+    min_y = std::min(min_y, y), max_y = std::max(max_y, y);
+  }
+  const double margin = rules.snapping_margin ? 1.0 / 64.0 : 0.0;
+  min_x -= margin, max_x += margin, min_y -= margin, max_y += margin;
+  if (!rules.pixel_centres) return max_x - min_x < 1.0 && max_y - min_y < 1.0;  // broken: a size threshold
+  // Centres lie at k + 0.5, k in [0, size): the rectangle holds one on an
+  // axis when the lowest centre at or past its start is at or before its end
+  // (rule 5). Both axes must hold one.
+  const auto holds_centre = [](double from, double to, int size) {
+    const double first = std::max(0.0, std::ceil(from - 0.5));
+    return first <= std::min(double(size - 1), std::floor(to - 0.5));
+  };
+  return !holds_centre(min_x, max_x, view.width) || !holds_centre(min_y, max_y, view.height);
+}
+
 View make_view(const glm::mat4& view, const glm::mat4& proj, int width, int height, const ClipSpace& clip) {
   limits::check_viewport(width, height, "viewport");
   check_finite(view, "view");

@@ -61,7 +61,8 @@ class ChcCuller final : public CpuTestedCuller {
       s.visible = false;  // invisible until shown otherwise
       s.last_visited = frame_;
       const BvhNode& node = index_.bvh.node(n);
-      if (node.object_count == 0 || view.frustum.classify(node.bounds) == Containment::outside)
+      if (node.object_count == 0 || view.frustum.classify(node.bounds) == Containment::outside ||
+          holds_no_sample(node.bounds, view))
         continue;
       if (near_eye(node.bounds, view, f_.near_radius)) {
         pull_up_visibility(state_, index_.bvh, n);

@@ -160,7 +160,9 @@ class GridCuller final : public Culler {
           if (drawn_[id] == frame_) continue;
           drawn_[id] = frame_;
           // The cell meets the frustum; the object may reach it only outside.
-          if (view.frustum.classify(scene_.object(id).bounds) == Containment::outside) continue;
+          if (view.frustum.classify(scene_.object(id).bounds) == Containment::outside ||
+            holds_no_sample(scene_.object(id).bounds, view))
+          continue;
           if (occludes(id, prepass)) {
             (conditional && in_one_cell(id) ? inside_ : prepass_).push_back(id);
             ++prepass;
@@ -217,7 +219,9 @@ class GridCuller final : public Culler {
       for (ObjectId id : grid_->objects(p.cell)) {
         if (drawn_[id] == frame_) continue;
         drawn_[id] = frame_;
-        if (view.frustum.classify(scene_.object(id).bounds) == Containment::outside) continue;
+        if (view.frustum.classify(scene_.object(id).bounds) == Containment::outside ||
+            holds_no_sample(scene_.object(id).bounds, view))
+          continue;
         colour_.push_back(id);
         p.useful = true;
       }

@@ -23,7 +23,8 @@ class StopWaitCuller final : public Culler {
       const NodeId n = queue.pop();
       ++stats.nodes_visited;
       const BvhNode& node = bvh.node(n);
-      if (node.object_count == 0 || view.frustum.classify(node.bounds) == Containment::outside)
+      if (node.object_count == 0 || view.frustum.classify(node.bounds) == Containment::outside ||
+          holds_no_sample(node.bounds, view))
         continue;
       if (!near_eye(node.bounds, view, radius)) {
         boxes_.clear();

@@ -23,7 +23,7 @@ class TileVfcCuller final : public Culler {
     queue_.clear();
     for (TileCoord c : cells_) {
       TileInstance& t = cache_.fetch(c);
-      collect_in_frustum_front_to_back(SceneIndex{index_.scene, *t.bvh, nullptr}, view, queue_, stats);
+      collect_in_frustum_front_to_back(SceneIndex{index_.scene, *t.bvh, nullptr}, view, queue_, stats, /*subpixel=*/false);  // the baseline: frustum only
       ++stats.tiles_rendered;
       cache_.note(world_.tile_box_at(c), true);
     }

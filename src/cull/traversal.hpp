@@ -165,14 +165,16 @@ class FrustumCache {
     ++frame_;
     view_ = &view;
   }
-  /// Whether node `n`'s box lies outside the frustum.
+  /// Whether node `n`'s box lies outside the frustum or holds no sample
+  /// (holds_no_sample: exact sub-pixel culling).
   bool outside(const Bvh& bvh, NodeId n) {
     Entry& e = nodes_[n];
     if (e.frame != frame_) {
       const NodeId parent = bvh.node(n).parent;
       std::uint32_t mask =
           parent != kNoNode && nodes_[parent].frame == frame_ ? nodes_[parent].planes : Frustum::all_planes;
-      e.outside = mask != 0 && view_->frustum.classify(bvh.node(n).bounds, mask) == Containment::outside;
+      e.outside = (mask != 0 && view_->frustum.classify(bvh.node(n).bounds, mask) == Containment::outside) ||
+                  holds_no_sample(bvh.node(n).bounds, *view_);
       e.planes = std::uint8_t(mask);
       e.frame = frame_;
     }
@@ -233,11 +235,15 @@ inline bool near_eye(const Aabb& box, const View& view, float radius) {
 
 /// Hierarchical frustum culling: appends every object whose box is not
 /// outside the frustum, nearest subtree first (plane masks skip the planes a
-/// node is fully inside). Counts visited nodes in stats.nodes_visited.
+/// node is fully inside), and, with `subpixel`, holds a sample
+/// (holds_no_sample skips whole subtrees). Counts visited nodes in
+/// stats.nodes_visited.
 void collect_in_frustum_front_to_back(const SceneIndex& index, const View& view,
-                                      std::vector<ObjectId>& out, FrameStats& stats);
+                                      std::vector<ObjectId>& out, FrameStats& stats, bool subpixel = true);
 
-/// Appends the objects of node `n` whose boxes are not outside the frustum.
+/// Appends the objects of node `n` whose boxes are not outside the frustum
+/// and hold a sample (occull/view.hpp holds_no_sample: exact sub-pixel
+/// culling; every culler but vfc skips such objects).
 /// `planes`: the frustum planes `n` is not known to lie fully inside (a
 /// Frustum plane mask); objects are tested against those only.
 void append_objects_in_frustum(const SceneIndex& index, NodeId n, const View& view,

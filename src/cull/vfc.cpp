@@ -17,7 +17,7 @@ class VfcCuller final : public Culler {
   FrameStats cull(const View& view, Backend& backend) override {
     FrameStats stats;
     queue_.clear();
-    collect_in_frustum_front_to_back(index_, view, queue_, stats);
+    collect_in_frustum_front_to_back(index_, view, queue_, stats, /*subpixel=*/false);  // the baseline: frustum only
     if (!queue_.empty()) backend.render(queue_);
     return stats;
   }

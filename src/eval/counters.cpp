@@ -83,6 +83,10 @@ constexpr std::array kCounters = std::to_array<Counter>({
      &S::depth_error_objects, -1, false, "count",
      "objects of the ground truth not drawn that only the rasteriser's depth errors show (fragments nearer than "
      "their own box): not missed"},
+    {"subpixel_objects", &F::subpixel_objects, none, C::sum, C::mean, C::median, "subpixel_objects_per_frame",
+     &S::subpixel_objects_per_frame, -1, false, "count",
+     "objects of the frustum whose boxes hold no pixel centre: they make no fragment, and every culler but vfc skips "
+     "them (verified runs)"},
     {"extra_objects", &F::extra_objects, none, C::sum, C::mean, C::median, "extra_objects_per_frame",
      &S::extra_objects_per_frame, -1, false, "count", "objects drawn that the ground truth does not show (over-drawing)"},
     {"blocking_waits", &F::blocking_waits, &B::blocking_waits, C::sum, C::mean, C::median, "blocking_waits_per_frame",

@@ -44,6 +44,23 @@ void check_truth_in_frustum(const FrameLabel& where, std::span<const gl::Rendere
                                      v.id, v.pixels));
 }
 
+std::uint32_t check_truth_holds_samples(const FrameLabel& where, std::span<const gl::Renderer::ObjectPixels> visible,
+                                        const Scene& scene, const View& view, const SubpixelRules& rules) {
+  for (const auto& v : visible)
+    if (holds_no_sample(scene.object(v.id).bounds, view, rules))
+      invariant_violated(where, "truth-holds-samples",
+                         fmt::format("object {} is in the truth ({} pixels) but its box holds no pixel centre by "
+                                     "the sub-pixel rule (holds_no_sample): the rule would cull a visible object",
+                                     v.id, v.pixels));
+  std::uint32_t count = 0;
+  for (ObjectId id = 0; id < scene.objects().size(); ++id) {
+    const Aabb& box = scene.object(id).bounds;
+    if (scene.alive(id) && view.frustum.classify(box) != Containment::outside && holds_no_sample(box, view, rules))
+      ++count;
+  }
+  return count;
+}
+
 void check_truth_covers_full_render(const FrameLabel& where, std::span<const std::uint32_t> ids,
                                     std::span<const float> depth, std::uint64_t outside_samples) {
   std::uint64_t id_only = 0, depth_only = 0;

@@ -3,6 +3,8 @@
 // InvariantViolation naming the invariant, scene, path and frame, because
 // a measurement against a broken ground truth is worse than none.
 //
+//   truth-holds-samples       no visible object of the truth holds no pixel
+//                             centre by the sub-pixel rule (holds_no_sample).
 //   truth-in-frustum          every visible object of the truth is one the
 //                             truth pass drew: an object inside the frustum
 //   truth-covers-full-render  the truth pass's id image covers exactly the
@@ -51,6 +53,12 @@ struct FrameLabel {
 /// truth-in-frustum. `drawn`: the ids the truth pass drew, ascending.
 void check_truth_in_frustum(const FrameLabel& where, std::span<const gl::Renderer::ObjectPixels> visible,
                             std::span<const ObjectId> drawn);
+
+/// truth-holds-samples: no object of the truth may hold no sample by the
+/// sub-pixel rule (holds_no_sample with `rules`; a test breaks them).
+/// Returns how many objects of the frustum hold none.
+std::uint32_t check_truth_holds_samples(const FrameLabel& where, std::span<const gl::Renderer::ObjectPixels> visible,
+                                        const Scene& scene, const View& view, const SubpixelRules& rules = {});
 
 /// truth-covers-full-render. `outside_samples`: samples of the objects
 /// outside the frustum that passed the depth test over the truth pass.

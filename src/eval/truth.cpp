@@ -162,6 +162,7 @@ FrameTruth Session::truth_of(const View& view, const detail::FrameLabel& where) 
   t.probes = std::uint32_t(detail::check_truth_probes(where, scene, view, in_frustum, images.depth,
                                                        renderer_options_.cull_backfaces));
   t.coverage = detail::depth_coverage(images.depth);
+  t.subpixel = detail::check_truth_holds_samples(where, t.visible, scene, view);
   t.depth_error_only = seen_only_through_depth_errors(scene, view, images.ids, images.depth, renderer_->width(),
                                                       renderer_->height());
   return t;
@@ -177,6 +178,7 @@ std::vector<ObjectId> Session::verify_frame(std::string_view name, const Culler&
   if (dynamic_cast<const detail::OracleCuller*>(&culler))
     detail::check_oracle_draws_truth(where, t.visible, recorder_->objects(), t.coverage.depth_hash,
                                      frame.depth_hash);
+  s.subpixel_objects = t.subpixel;
   return check_frame(t.visible, recorder_->objects(), bundle_.scene.objects().size(), s, t.depth_error_only);
 }
 

@@ -90,6 +90,7 @@ uniform ivec2 u_level_size[16];
 uniform ivec2 u_clip;      // x: 1 for depth range [0, 1]; y: 1 for reversed-Z
 uniform bool u_compact;
 uniform int u_texels;      // texels per axis a test reads at most: 2, 4 or 8
+uniform bool u_subpixel;   // the view is single-sampled at this size: boxes that hold no pixel centre are skipped
 
 bool in_frustum(vec3 lo, vec3 hi) {
   for (int k = 0; k < 6; ++k) {
@@ -99,6 +100,32 @@ bool in_frustum(vec3 lo, vec3 hi) {
     if (dot(p.xyz, far_corner) + p.w < -slack) return false;
   }
   return true;
+}
+
+// Exact sub-pixel culling, by the rules of occull::holds_no_sample
+// (occull/view.hpp): the box grown by 2^-20 of its coordinates, every corner
+// beyond the near plane, the rectangle widened by 1/64 pixel, and no pixel
+// centre in it. (In float here: the corners are taken relative to the eye as
+// the scene's vertices are, which keeps the error far below the margin.)
+bool holds_no_sample(vec3 lo, vec3 hi) {
+  if (!u_subpixel) return false;
+  float grow = exp2(-20.0) * max(max(max(abs(lo.x), abs(lo.y)), max(abs(lo.z), abs(hi.x))), max(abs(hi.y), abs(hi.z)));
+  lo -= vec3(grow);
+  hi += vec3(grow);
+  vec2 rmin = vec2(1e30), rmax = vec2(-1e30);
+  for (int i = 0; i < 8; ++i) {
+    vec3 c = vec3((i & 1) != 0 ? hi.x : lo.x, (i & 2) != 0 ? hi.y : lo.y, (i & 4) != 0 ? hi.z : lo.z);
+    vec4 h = u_view_proj * vec4(c - u_eye, 1.0);
+    if (h.w <= 0.0) return false;
+    bool beyond_near = u_clip.y != 0 ? h.z < h.w : h.z > (u_clip.x != 0 ? 0.0 : -1.0) * h.w;
+    if (!beyond_near) return false;
+    vec2 px = (h.xy / h.w * 0.5 + 0.5) * u_viewport;
+    rmin = min(rmin, px);
+    rmax = max(rmax, px);
+  }
+  vec2 first = max(vec2(0.0), ceil(rmin - 1.0 / 64.0 - 0.5));
+  vec2 last = min(u_viewport - 1.0, floor(rmax + 1.0 / 64.0 - 0.5));
+  return any(greaterThan(first, last));
 }
 
 // Larger is farther.
@@ -155,7 +182,7 @@ void main() {
   if (i >= u_objects) return;
   DeviceObject o = objects[i];
   bool translucent = (o.flags & 2u) != 0u;
-  bool inside = (o.flags & 1u) != 0u && in_frustum(o.bmin.xyz, o.bmax.xyz);
+  bool inside = (o.flags & 1u) != 0u && in_frustum(o.bmin.xyz, o.bmax.xyz) && !holds_no_sample(o.bmin.xyz, o.bmax.xyz);
   if (u_phase == 1) {
     bool draw = inside && !translucent && visible[i] != 0u;
     if (draw) drawn[i] = 1u;
@@ -227,6 +254,7 @@ void Renderer::Impl::create_device() {
   d.u_clip = cull_uniform("u_clip");
   d.u_compact = cull_uniform("u_compact");
   d.u_texels = cull_uniform("u_texels");
+  d.u_subpixel = cull_uniform("u_subpixel");
   d.u_pyr_from_depth = glGetUniformLocation(d.pyramid_program, "u_from_depth");
   d.u_pyr_src_size = glGetUniformLocation(d.pyramid_program, "u_src_size");
   d.u_pyr_dst_size = glGetUniformLocation(d.pyramid_program, "u_dst_size");
@@ -345,6 +373,7 @@ void Renderer::Impl::start_device_frame() {
   glProgramUniform2iv(p, d.u_level_size, GLsizei(d.level_size.size()), d.level_size[0].data());
   glProgramUniform2i(p, d.u_clip, clip.depth == DepthRange::zero_to_one ? 1 : 0, clip.reversed_z ? 1 : 0);
   glProgramUniform1i(p, d.u_compact, d.compact ? 1 : 0);
+  glProgramUniform1i(p, d.u_subpixel, view.samples == 1 && view.width == options.width && view.height == options.height);
   glProgramUniformMatrix4fv(d.draw_program, d.u_draw_view_proj, 1, GL_FALSE, glm::value_ptr(view_proj_relative));
   glProgramUniform3fv(d.draw_program, d.u_draw_eye, 1, glm::value_ptr(view.eye));
   glProgramUniform3fv(d.draw_program, d.u_draw_background, 1, glm::value_ptr(options.background));

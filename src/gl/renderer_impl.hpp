@@ -65,7 +65,7 @@ struct DeviceState {
   bool timestamps = false;          // the device has GL_TIMESTAMP
   bool pyramid_built = false;       // build_depth_pyramid() ran this frame
   GLint u_phase = -1, u_objects = -1, u_region = -1, u_view_proj = -1, u_planes = -1, u_viewport = -1,
-        u_levels = -1, u_level_size = -1, u_clip = -1, u_compact = -1, u_texels = -1, u_eye = -1;
+        u_levels = -1, u_level_size = -1, u_clip = -1, u_compact = -1, u_texels = -1, u_eye = -1, u_subpixel = -1;
   GLint u_draw_view_proj = -1, u_draw_eye = -1, u_draw_background = -1, u_draw_fog = -1;
   GLint u_pyr_from_depth = -1, u_pyr_src_size = -1, u_pyr_dst_size = -1, u_pyr_reversed = -1;
 };
