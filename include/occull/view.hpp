@@ -62,6 +62,12 @@ struct View {
 ///     kept (its rectangle means nothing).
 ///  5. A centre on the rectangle's edge is inside (ties keep the box).
 /// Returns false ("may make a fragment") for an empty box too.
+/// The projection times the view's rotation, in double: what positions
+/// relative to the eye (world - eye) are projected by. The renderer projects
+/// this way (small numbers near the camera whatever the coordinates' size),
+/// and so does holds_no_sample.
+[[nodiscard]] glm::dmat4 eye_relative_projection(const View& view) noexcept;
+
 struct SubpixelRules {
   bool grow_for_rounding = true;  ///< rule 2
   bool snapping_margin = true;    ///< rule 3's widening

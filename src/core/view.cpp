@@ -31,6 +31,10 @@ std::string depth_name(const ClipSpace& clip) {
 
 }  // namespace
 
+glm::dmat4 eye_relative_projection(const View& view) noexcept {
+  return glm::dmat4(view.proj) * glm::dmat4(glm::dmat3(glm::mat3(view.view)));
+}
+
 bool holds_no_sample(const Aabb& box, const View& view, const SubpixelRules& rules) noexcept {
   if (view.samples != 1 || box.empty()) return false;  // rule 1
   glm::dvec3 lo(box.min), hi(box.max);
@@ -42,7 +46,7 @@ bool holds_no_sample(const Aabb& box, const View& view, const SubpixelRules& rul
     hi += grow;
   }
   // Rule 3: eye-relative, in double.
-  const glm::dmat4 m = glm::dmat4(view.proj) * glm::dmat4(glm::dmat3(glm::mat3(view.view)));
+  const glm::dmat4 m = eye_relative_projection(view);
   const glm::dvec3 eye(view.eye);
   const double near_depth = double(view.clip.near_depth());
   double min_x = std::numeric_limits<double>::infinity(), max_x = -min_x, min_y = min_x, max_y = -min_x;

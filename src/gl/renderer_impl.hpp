@@ -98,9 +98,7 @@ struct Renderer::Impl {
   // float units at coordinates of 2 km (the large terms of z and w cancel,
   // each rounded on its own), and query boxes then lose to the walls their
   // objects stand a millimetre in front of.
-  [[nodiscard]] static glm::mat4 eye_relative(const View& v) {
-    return glm::mat4(glm::dmat4(v.proj) * glm::dmat4(glm::dmat3(glm::mat3(v.view))));
-  }
+  [[nodiscard]] static glm::mat4 eye_relative(const View& v) { return glm::mat4(eye_relative_projection(v)); }
   glm::mat4 view_proj_relative{1.0f};  // eye_relative(view) of the current pass (prepare_pass)
   // The clip conventions of the pass's view: depth range, and with reversed-Z
   // the depth tests, the depth clear and the polygon offset turn around.
