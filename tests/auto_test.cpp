@@ -6,7 +6,10 @@
 #include "occull/error.hpp"
 #include "test_util.hpp"
 
+#include <glm/gtc/matrix_transform.hpp>
 #include <gtest/gtest.h>
+
+#include <functional>
 
 using namespace occull;
 
@@ -167,6 +170,22 @@ TEST(AutoSchedule, ADisabledCandidateNeverRuns) {
   for (std::size_t k = 50; k < ran.size(); ++k) EXPECT_EQ(ran[k], 2u) << "frame " << k;
 }
 
+TEST(AutoSchedule, AnUnmeasuredFrameIsNotCounted) {
+  detail::AutoSchedule s(config(), 2);
+  s.finished(1.0);  // the uncounted first frame: candidate 0's try comes next
+  s.finished(1.0);
+  s.finished(1.0);  // candidate 0 measured at 1; candidate 1's try starts
+  ASSERT_EQ(s.next(), 1u);
+  ASSERT_TRUE(s.starts_try());
+  s.unmeasured();  // a frame that measures nothing (a camera cut): its cost is not seen
+  EXPECT_EQ(s.next(), 1u) << "the try goes on";
+  EXPECT_FALSE(s.starts_try()) << "the same try, not a new one";
+  s.finished(0.5);
+  s.finished(0.5);
+  EXPECT_EQ(s.current(), 1u) << "judged on its two measured frames";
+  EXPECT_EQ(s.tries(), 2u) << "the start's round: one try each; the unmeasured frame began none";
+}
+
 TEST(AutoCuller, SwitchesWhenTheBackendsCostsChange) {
   // Boxes in a row in front of the camera; vfc never queries, chcpp does.
   std::vector<Aabb> boxes;
@@ -228,6 +247,27 @@ TEST(AutoCuller, RecordsTheCandidateOfEachFrameAndItsTries) {
   EXPECT_EQ(tries, (std::vector<std::uint64_t>{0, 1, 0, 1, 0, 0}));
 }
 
+TEST(AutoCuller, PredictsEachFramesCostFromItsCandidatesLastMeasure) {
+  const Scene scene = test::box_scene({{{-1, -1, -5}, {1, 1, -4}}, {{-1, -1, -9}, {1, 1, -8}}});
+  const Bvh bvh = Bvh::build(scene);
+  Options o;
+  o.set("auto.candidates", "vfc+chcpp");
+  const auto culler = make_culler("auto", {scene, bvh}, o);
+  const View view = make_view({{0, 0, 0}, 0, 0}, {60.0f, 0.1f, 200.0f}, 64, 64);
+  test::ScriptedBackend backend;
+  std::vector<double> predicted;
+  for (int k = 0; k < 8; ++k) {
+    const FrameStats s = culler->render_frame(view, backend);
+    predicted.push_back(s.auto_predicted_ms);
+    FrameStats measured;
+    measured.frame_ms = s.auto_choice == 1 ? 1.5 : 4.0;
+    culler->frame_finished(measured);
+  }
+  EXPECT_EQ(predicted[0], 0.0) << "nothing measured yet";
+  EXPECT_EQ(predicted[3], 0.0) << "chcpp's first try: never measured";
+  EXPECT_NEAR(predicted[7], 1.5, 1e-9) << "vfc kept, on the same view: its measured 1.5 ms";
+}
+
 TEST(AutoCuller, HandsOverTheVisibleSetTheQueryCullersTakeAsTheirLastFrames) {
   std::vector<Aabb> boxes;
   for (int i = 0; i < 12; ++i) boxes.push_back({{-1.0f, -1.0f, -5.0f - 3.0f * float(i)}, {1.0f, 1.0f, -4.0f - 3.0f * float(i)}});
@@ -259,5 +299,73 @@ TEST(AutoCuller, RejectsItselfAndTheOracleAsCandidates) {
     Options o;
     o.set("auto.candidates", bad);
     EXPECT_THROW((void)make_culler("auto", {scene, bvh}, o), InputError) << bad;
+  }
+}
+
+namespace {
+
+// Auto over `candidates` (two) on boxes in a row; `cost(choice, k)` is the
+// measured time of frame k run by candidate `choice` (1 or 2), `view_of(k)`
+// its view. Returns the candidate of each frame.
+std::vector<std::uint32_t> auto_frames(const std::function<double(std::uint32_t, int)>& cost,
+                                       const std::function<View(int)>& view_of, int frames,
+                                       const char* candidates = "vfc+chcpp") {
+  std::vector<Aabb> boxes;
+  for (int i = 0; i < 8; ++i) boxes.push_back({{-1.0f, -1.0f, -5.0f - 3.0f * float(i)}, {1.0f, 1.0f, -4.0f - 3.0f * float(i)}});
+  const Scene scene = test::box_scene(boxes);
+  const Bvh bvh = Bvh::build(scene);
+  Options o;
+  o.set("auto.candidates", candidates);
+  o.set("auto.period", "1000");
+  const auto culler = make_culler("auto", {scene, bvh}, o);
+  test::ScriptedBackend backend;
+  std::vector<std::uint32_t> choice;
+  for (int k = 0; k < frames; ++k) {
+    const FrameStats s = culler->render_frame(view_of(k), backend);
+    choice.push_back(s.auto_choice);
+    FrameStats measured;
+    measured.frame_ms = cost(s.auto_choice, k);
+    culler->frame_finished(measured);
+  }
+  return choice;
+}
+
+View looking_down_z(glm::vec3 eye, float yaw_degrees = 0.0f) {
+  return make_view({eye, glm::radians(yaw_degrees), 0.0f}, {60.0f, 0.1f, 200.0f}, 64, 64);
+}
+
+}  // namespace
+
+TEST(AutoCuller, AFrameAfterACameraCutIsNotMeasured) {
+  // A jump to the other side of the row as chcpp's try begins: the cut's
+  // frame costs 10x (every culler starts over there) and is not held against it.
+  const auto view_of = [](int k) { return k < 4 ? looking_down_z({0, 0, 0}) : looking_down_z({0, 0, -40}, 180.0f); };
+  const auto choice = auto_frames([](std::uint32_t c, int k) { return k == 4 ? 20.0 : (c == 1 ? 2.0 : 1.0); },
+                                  view_of, 12);
+  EXPECT_EQ(choice.back(), 2u) << "chcpp, measured after the cut, is kept";
+  // Broken on purpose (a walk, not a jump): the same costs, the view turned 1 degree.
+  const auto walk = auto_frames([](std::uint32_t c, int k) { return k == 4 ? 20.0 : (c == 1 ? 2.0 : 1.0); },
+                                [](int k) { return looking_down_z({0, 0, 0}, k < 4 ? 0.0f : 1.0f); }, 12);
+  EXPECT_EQ(walk.back(), 1u) << "without a cut the expensive frame counts and chcpp's try is cut";
+}
+
+TEST(AutoCuller, ACpuOcclusionBufferIsNoCandidateWithoutVertices) {
+  Scene scene;
+  const MaterialId m = scene.add_material({});
+  const MeshId mesh = scene.add_mesh(MeshInfo{{{-1, -1, -1}, {1, 1, 1}}, 12, 24.0});
+  for (int i = 0; i < 4; ++i)
+    (void)scene.add_object(mesh, m, glm::translate(glm::mat4(1.0f), glm::vec3(0, 0, -5.0f - 3.0f * float(i))),
+                           OccluderClass::always);
+  const Bvh bvh = Bvh::build(scene);
+  Options o;
+  o.set("auto.candidates", "soc+vfc");
+  const auto culler = make_culler("auto", {scene, bvh}, o);
+  test::ScriptedBackend backend;
+  for (int k = 0; k < 20; ++k) {
+    const FrameStats s = culler->render_frame(looking_down_z({0, 0, 0}), backend);
+    EXPECT_EQ(s.auto_choice, 2u) << "frame " << k << ": soc cannot occlude with no vertex";
+    FrameStats measured;
+    measured.frame_ms = s.auto_choice == 1 ? 1.0 : 5.0;
+    culler->frame_finished(measured);
   }
 }

@@ -81,6 +81,29 @@ TEST(OsgCullingGroup, ABoxBehindAWallIsNotDrawnAndAVisibleOneIs) {
   EXPECT_TRUE(drew(*s.group, v.camera(), hidden));
 }
 
+TEST(OsgCullingGroup, TheFrameTimeTheApplicationMeasuresReachesAnAdaptiveCuller) {
+  // auto between vfc and chcpp; the application reports vfc's frames as
+  // 100x chcpp's. Inside its draw callback chcpp's queries cost more than
+  // vfc's three boxes, so only the reported times make it keep chcpp.
+  HeadlessViewer v(64, 64);
+  Walled s;
+  occull::Options o;
+  o.set("auto.candidates", "vfc+chcpp");
+  s.group->set_algorithm("auto", o);
+  v.set_scene(s.group.get());
+  std::uint32_t choice = 0;
+  for (int k = 0; k < 12; ++k) {
+    v.frame(camera_view(), 0.1 * k);
+    const osgOccull::CameraFrame* f = s.group->last_frame(&v.camera());
+    ASSERT_NE(f, nullptr);
+    choice = f->culler.auto_choice;
+    occull::FrameStats measured;
+    measured.frame_ms = choice == 1 ? 100.0 : 1.0;
+    s.group->frame_finished(&v.camera(), measured);
+  }
+  EXPECT_EQ(choice, 2u) << "auto keeps chcpp, the cheaper by the frame times reported";
+}
+
 TEST(OsgCullingGroup, OsgsOwnFrustumAndSmallFeatureCullingDoNotChangeWhatTheGroupDraws) {
   std::vector<occull::ObjectId> drawn[2];
   for (int k = 0; k < 2; ++k) {

@@ -95,6 +95,9 @@ struct AlgorithmSummary {
   double model_ms_per_frame = 0.0;        ///< cost-model prediction (0 without --model)
   double auto_tries = 0.0;                ///< auto: tries of a challenger over the run (FrameStats::auto_tries)
   double auto_switches = 0.0;             ///< auto: changes of the culler kept over the run
+  /// auto: median over the frames it predicted of |predicted − measured| /
+  /// measured frame time (FrameStats::auto_predicted_ms); 0 for the others.
+  double auto_prediction_error = 0.0;
   /// auto: each candidate (Culler::choices(), in order) and the share of
   /// the frames it ran, over every repeat; empty for the other cullers.
   std::vector<std::pair<std::string, double>> auto_choices;

@@ -205,6 +205,11 @@ struct AlgorithmInfo {
   /// (Backend::device_culling()), and render_frame() throws InputError on
   /// one that does not.
   bool device = false;
+  /// Occludes only with the triangles of meshes whose vertices the scene
+  /// holds (`soc`): on a scene of meshes registered by MeshInfo alone (an
+  /// engine keeps the vertices, as OpenSceneGraph's group does) it culls by
+  /// the frustum only.
+  bool cpu_occluders = false;
 };
 
 /// Every algorithm make_culler() knows, in presentation order.

@@ -50,6 +50,10 @@ struct FrameStats {
   std::uint32_t auto_choice = 0;   ///< 1 + index in Culler::choices() of the candidate auto ran this frame; 0: not auto
   std::uint64_t auto_tries = 0;    ///< 1 on the first frame of a try of a challenger (not the culler auto keeps)
   std::uint64_t auto_switches = 0; ///< 1 on the first frame of a new culler kept (it won its try)
+  /// Its cost for this frame's candidate, predicted before running it: the
+  /// candidate's last measured cost per unit of frame content times this
+  /// frame's content, ms (0: none yet, or a frame after a camera cut).
+  double auto_predicted_ms = 0.0;
 
   // Tiled worlds (tilevfc, pertile, tiles; Gomez et al. 2013).
   std::uint64_t tiles_rendered = 0;      ///< tile instances drawn (culled inside by their own culler, if any)

@@ -52,6 +52,7 @@ AutoSchedule::AutoSchedule(AutoConfig config, std::size_t candidates)
 void AutoSchedule::start_trial(std::size_t c) {
   running_ = c;
   in_trial_ = true;
+  restarted_ = false;
   trial_frame_ = 0;
   samples_.clear();
   if (!cold_) ++tries_;
@@ -164,6 +165,16 @@ void AutoSchedule::choose_next() {
   }
 }
 
+void AutoSchedule::unmeasured() {
+  if (cold_) {  // the first frame is not counted anyway
+    finished(0.0);
+    return;
+  }
+  ++frame_;
+  switched_ = false;
+  if (in_trial_ && trial_frame_ == 0) restarted_ = true;  // the try goes on: its first frame has run
+}
+
 void AutoSchedule::finished(double cost) {
   ++frame_;
   switched_ = false;
@@ -269,23 +280,36 @@ class FrustumContent {
   bool known_ = false;
 };
 
+// A camera cut: between two frames the view turned by more than
+// kCutDegrees or its eye moved more than kCutShare of the scene's diagonal
+// (a jump to another place, not a walk: a walk at 30 fps moves well under
+// 1 %). After one, temporal cullers start over (their last frame says
+// nothing of this one), so the cut's frame and the next kCutFrames - 1
+// are not measured: a try there would judge a culler by its restart.
+constexpr float kCutDegrees = 30.0f;
+constexpr float kCutShare = 0.05f;
+constexpr int kCutFrames = 2;
+
 struct Candidate {
   std::string spec;
   std::unique_ptr<Culler> culler;
   bool device = false;     // culls on the device (hiz): needs Backend::device_culling()
   bool frustum = false;    // draws the whole frustum (vfc): its cost is estimated from others' frames
+  bool cpu_occluders = false;  // occludes with the scene's vertices only (soc): needs meshes that have them
   std::uint64_t last_frame = 0;  // auto's frame it last ran (0: never)
 };
 
 class AutoCuller final : public Culler {
  public:
   AutoCuller(const SceneIndex& index, std::vector<Candidate> candidates, const AutoConfig& config)
-      : content_of_(index), candidates_(std::move(candidates)), schedule_(config, candidates_.size()) {}
+      : scene_(index.scene), content_of_(index), candidates_(std::move(candidates)),
+        schedule_(config, candidates_.size()) {}
 
   FrameStats cull(const View& view, Backend& backend) override {
     if (!started_) start(backend);
     if (awaiting_feedback_) finished(FrameStats{});  // the owner did not call frame_finished
     content_ = content_of_(view, false);
+    after_cut_ = camera_cut(view) ? kCutFrames : std::max(after_cut_, 1) - 1;
     // vfc's estimate needs the frustum's exact content; it is measured now
     // and then (the estimate only spares tries), its share of the rough one kept.
     if (frame_ % kExactEvery == 0) exact_share_ = content_of_(view, true) / content_;
@@ -293,6 +317,8 @@ class AutoCuller final : public Culler {
     if (run != last_ && last_ < candidates_.size()) hand_over(last_, run);
     candidates_[run].last_frame = ++frame_;
     const bool tried = schedule_.starts_try(), switched = schedule_.just_switched();
+    // The prediction: the candidate's last measured cost per unit of content (0 before its first).
+    const double predicted = after_cut_ > 0 ? 0.0 : schedule_.cost(run) * content_;
     const auto t0 = std::chrono::steady_clock::now();
     FrameStats s = candidates_[run].culler->render_frame(view, backend);
     own_ms_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
@@ -301,6 +327,7 @@ class AutoCuller final : public Culler {
     s.auto_choice = std::uint32_t(run + 1);
     s.auto_tries = tried ? 1 : 0;
     s.auto_switches = switched ? 1 : 0;
+    s.auto_predicted_ms = predicted;
     return s;
   }
 
@@ -326,12 +353,20 @@ class AutoCuller final : public Culler {
   }
 
  private:
-  // The first frame: candidates that cannot run on this backend never will.
+  // The first frame: candidates that cannot run on this backend never will,
+  // nor can a CPU occlusion buffer cull in a scene whose meshes have no
+  // vertices on the CPU (it would be vfc with a buffer's cost).
   void start(Backend& backend) {
     started_ = true;
+    const Aabb world = scene_.bounds();
+    scene_diagonal_ = world.empty() ? 0.0f : glm::length(world.extent());
+    const auto meshes = scene_.meshes();
+    const bool vertices =
+        std::any_of(meshes.begin(), meshes.end(), [](const Mesh& m) { return !m.positions.empty(); });
     std::size_t left = candidates_.size();
     for (std::size_t c = 0; c < candidates_.size(); ++c)
-      if (candidates_[c].device && !backend.device_culling() && left > 1) {
+      if (((candidates_[c].device && !backend.device_culling()) || (candidates_[c].cpu_occluders && !vertices)) &&
+          left > 1) {
         schedule_.disable(c);
         --left;
       }
@@ -352,7 +387,10 @@ class AutoCuller final : public Culler {
       for (std::size_t c = 0; c < candidates_.size(); ++c)
         if (candidates_[c].frustum) schedule_.estimate(c, per_unit * exact_share_);
     }
-    schedule_.finished((measured.frame_ms > 0.0 ? measured.frame_ms : own_ms_) / content_);
+    if (after_cut_ > 0)
+      schedule_.unmeasured();
+    else
+      schedule_.finished((measured.frame_ms > 0.0 ? measured.frame_ms : own_ms_) / content_);
   }
 
   // `to` runs after `from` ran last frame: hands it the visibility `from`
@@ -369,7 +407,23 @@ class AutoCuller final : public Culler {
     resumable->resume_from(drawn);
   }
 
+  // Whether the view jumped since the last frame (see kCutDegrees).
+  bool camera_cut(const View& view) {
+    const glm::vec3 forward = -glm::vec3(view.view[0][2], view.view[1][2], view.view[2][2]);
+    const bool cut = seen_view_ && (glm::dot(forward, last_forward_) < std::cos(glm::radians(kCutDegrees)) ||
+                                    glm::distance(view.eye, last_eye_) > kCutShare * scene_diagonal_);
+    seen_view_ = true;
+    last_forward_ = forward;
+    last_eye_ = view.eye;
+    return cut;
+  }
+
+  const Scene& scene_;
   FrustumContent content_of_;
+  float scene_diagonal_ = 0.0f;
+  bool seen_view_ = false;
+  glm::vec3 last_forward_{0.0f}, last_eye_{0.0f};
+  int after_cut_ = 0;  // frames left that are not measured: the cut's and kCutFrames - 1 after it
   double content_ = 1.0;      // this frame's, roughly
   double exact_share_ = 1.0;  // exact content / rough content, when last measured
   std::vector<Candidate> candidates_;
@@ -420,7 +474,8 @@ Registration auto_registration() {
             throw InputError(fmt::format("option auto.candidates: '{}' cannot be a candidate (auto runs conservative "
                                          "cullers other than itself)",
                                          name));
-          candidates.push_back({name, make_culler(name, index, o, context), info.device, info.name == "vfc"});
+          candidates.push_back(
+              {name, make_culler(name, index, o, context), info.device, info.name == "vfc", info.cpu_occluders});
         }
         return std::make_unique<AutoCuller>(index, std::move(candidates), c);
       });

@@ -58,12 +58,16 @@ class AutoSchedule {
   [[nodiscard]] std::size_t next() const noexcept { return running_; }
   /// Whether next() runs the first frame of a try (the start's round
   /// included: every candidate's first measured frame).
-  [[nodiscard]] bool starts_try() const noexcept { return in_trial_ && !cold_ && trial_frame_ == 0; }
+  [[nodiscard]] bool starts_try() const noexcept { return in_trial_ && !cold_ && trial_frame_ == 0 && !restarted_; }
   /// Whether the last finished() made a challenger the current.
   [[nodiscard]] bool just_switched() const noexcept { return switched_; }
   /// Reports the cost of the frame just run by next() and chooses the next
   /// frame's candidate.
   void finished(double cost);
+  /// The frame just run by next() is not a measure (it followed a camera
+  /// cut: every temporal culler starts over there): it is not counted; a try
+  /// in progress goes on and is judged on its measured frames.
+  void unmeasured();
   /// Never runs candidate `c` again (it cannot run here: hiz on a backend
   /// without device culling). Precondition: some other candidate remains.
   void disable(std::size_t c);
@@ -98,6 +102,7 @@ class AutoSchedule {
   bool initial_ = true;            // the first round: every candidate once
   bool cold_ = true;               // the very first frame: not counted
   bool switched_ = false;
+  bool restarted_ = false;         // the try in progress ran its first frame, unmeasured
   int trial_frame_ = 0;
   std::uint64_t frame_ = 0;
   std::uint64_t switches_ = 0;

@@ -125,7 +125,8 @@ Registration soc_registration() {
           .flag("simd", &SocConfig::simd, "vectorised inner loops (off: the scalar reference, equal bit for bit)");
   return registered({"soc",
                      "software occlusion culling: a strictly conservative CPU occlusion buffer, occluders "
-                     "rasterized front to back as they are met, no queries"},
+                     "rasterized front to back as they are met, no queries",
+                     true, {}, false, SceneKind::bvh, false, false, true},
                     table, [](const SceneIndex& index, const SocConfig& config, const Options&, const CullerContext&) {
                       return std::make_unique<SocCuller>(index, config);
                     });

@@ -48,6 +48,9 @@ constexpr std::array kCounters = std::to_array<Counter>({
      "auto: 1 on the first frame of a try of a challenger"},
     {"auto_switches", &F::auto_switches, none, C::sum, C::sum, C::median, "auto_switches", &S::auto_switches, -1,
      false, "0/1", "auto: 1 on the first frame of a new culler kept (a challenger that won its try)"},
+    {"auto_predicted_ms", &F::auto_predicted_ms, none, C::sum, C::none, C::none, "", none, 4, false, "ms",
+     "auto: the frame time it predicted for the candidate it ran, before running it (0: no prediction); beside "
+     "frame_ms, how well its model knows the candidates"},
     {"queries", &F::queries, &B::queries, C::sum, C::mean, C::median, "queries_per_frame", &S::queries_per_frame, -1,
      false, "count", "occlusion queries issued"},
     {"query_boxes", &F::query_boxes, &B::query_boxes, C::sum, C::none, C::none, "", none, -1, false, "count",

@@ -120,8 +120,12 @@ std::string auto_line(const BenchResult& r, const AlgorithmSummary& a) {
   std::string ran;
   for (const auto& [candidate, share] : a.auto_choices)
     ran += fmt::format("{}{} {:.0f}%", ran.empty() ? "" : ", ", candidate, 100.0 * share);
-  return fmt::format("{}: ran {} of the frames; {:.0f} tries of a challenger, {:.0f} switches{}", a.name, ran,
-                     a.auto_tries, a.auto_switches, r.repeat > 1 ? " (median of the repeats)" : "");
+  const std::string predicted =
+      a.auto_prediction_error > 0.0
+          ? fmt::format("; each frame's cost predicted within {:.0f}% (median)", 100.0 * a.auto_prediction_error)
+          : "";
+  return fmt::format("{}: ran {} of the frames; {:.0f} tries of a challenger, {:.0f} switches{}{}", a.name, ran,
+                     a.auto_tries, a.auto_switches, predicted, r.repeat > 1 ? " (median of the repeats)" : "");
 }
 
 std::string misses_text(const BenchResult& r, std::uint64_t v) {
@@ -291,6 +295,8 @@ nlohmann::ordered_json detail::bench_json(const BenchResult& r) {
     ordered_json choices;  // null for the cullers other than auto
     for (const auto& [candidate, share] : a.auto_choices) choices[candidate] = share;
     algos.back()["auto_choices"] = choices;
+    algos.back()["auto_prediction_error"] =
+        a.auto_choices.empty() ? ordered_json(nullptr) : ordered_json(a.auto_prediction_error);
   }
   doc["algorithms"] = algos;
   return doc;

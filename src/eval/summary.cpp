@@ -121,6 +121,11 @@ std::vector<AlgorithmSummary> summarize_runs(std::span<const AlgorithmRun> runs)
             for (const std::string& c : r.choices) a.auto_choices.emplace_back(c, 0.0);
           a.auto_choices[f.auto_choice - 1].second += 1.0;
         }
+      std::vector<double> errors;  // auto's prediction of the frame it ran, against the measure
+      for (const FrameStats& f : r.frames)
+        if (f.auto_predicted_ms > 0.0 && f.frame_ms > 0.0)
+          errors.push_back(std::abs(f.auto_predicted_ms - f.frame_ms) / f.frame_ms);
+      if (!errors.empty()) per_repeat["auto_prediction_error"].push_back(median_of(std::move(errors)));
       if (a.first_miss.empty()) a.first_miss = r.first_miss;
       // A view of a split-screen run compares with the same view of the baseline.
       const std::size_t view_at = r.name.find(" [view ");
@@ -156,6 +161,7 @@ std::vector<AlgorithmSummary> summarize_runs(std::span<const AlgorithmRun> runs)
     a.ratio_to_vfc = med("ratio_to_vfc");
     a.ratio_to_oracle = med("ratio_to_oracle");
     a.cpu_us_per_node = med("cpu_us_per_node");
+    a.auto_prediction_error = med("auto_prediction_error");
     a.tile_prediction_failure_share = med("tile_prediction_failure_share");
     a.instantiate_ms_per_tile = med("instantiate_ms_per_tile");
     out.push_back(std::move(a));

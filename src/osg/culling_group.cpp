@@ -157,6 +157,12 @@ const CameraFrame* OcclusionCullingGroup::last_frame(const ::osg::Camera* camera
   return it == state_->cameras.end() ? nullptr : &it->second.frame;
 }
 
+void OcclusionCullingGroup::frame_finished(const ::osg::Camera* camera, const FrameStats& measured) {
+  std::lock_guard lock(mutex_);
+  const auto it = state_->cameras.find(camera);
+  if (it != state_->cameras.end() && it->second.culler) it->second.culler->frame_finished(measured);
+}
+
 void OcclusionCullingGroup::traverse(::osg::NodeVisitor& nv) {
   if (nv.getVisitorType() != ::osg::NodeVisitor::CULL_VISITOR) {
     ::osg::Group::traverse(nv);

@@ -327,6 +327,17 @@ BenchResult run_osg_bench(const OsgBenchConfig& config, const ProgressFn& progre
         update_exported(scene, graph.exported);
         kept.clear();
         const double frame_ms = device->frame(session.view_at(path, k, config.frames), t);
+        if (graph.group) {  // the frame's measured time reaches the camera's culler, as Session does for occull's rows
+          FrameStats measured;
+          if (const CameraFrame* f = graph.group->last_frame(camera)) {
+            measured = f->culler;
+            measured.draw_calls = measured.objects_rendered = f->drawn.size();
+            measured.triangles = 0;
+            for (ObjectId id : f->drawn) measured.triangles += scene.object(id).triangles;
+          }
+          measured.frame_ms = frame_ms;
+          graph.group->frame_finished(camera, measured);
+        }
         if (progress) progress(label, warm ? step : step - config.warmup, warm ? config.warmup : config.frames, warm);
         if (warm) continue;
         FrameStats stats;

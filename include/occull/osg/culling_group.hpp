@@ -130,6 +130,14 @@ class OcclusionCullingGroup : public ::osg::Group {
   [[nodiscard]] const occull::Scene& scene() const noexcept;
   /// What `camera` drew in its last frame; null for a camera never drawn.
   [[nodiscard]] const CameraFrame* last_frame(const ::osg::Camera* camera) const;
+  /// Optional feedback, as occull::Culler::frame_finished: once `camera`'s
+  /// frame is complete (after viewer.frame(), with the GPU's work finished or
+  /// timed), what the application measured of it — frame_ms at least, the
+  /// whole frame's time in milliseconds. Adaptive cullers (`auto`) choose by
+  /// it; without it they fall back to their own time inside the draw, which
+  /// in OSG misses the draws the GPU runs after it (docs/osg.md). Ignored
+  /// for a camera the group has not drawn. Thread-safe with the group's draw.
+  void frame_finished(const ::osg::Camera* camera, const occull::FrameStats& measured);
 
  protected:
   ~OcclusionCullingGroup() override;
