@@ -241,7 +241,7 @@ TEST(OsgCullingGroup, ACullerThatNeedsDeviceCullingIsRefusedAtOnce) {
 TEST(OsgBench, OccullRowsInsideOsgMissNoVisibleObjectOverAPath) {
   osgOccull::OsgBenchConfig c;
   c.scene = "city:blocks=3";
-  c.rows = {"osg", "oqn", "vfc", "chcpp", "stopwait"};
+  c.rows = {"osg", "oqn", "vfc", "chcpp", "stopwait", "auto"};
   c.frames = 24;
   c.warmup = 2;
   c.width = 160;
@@ -253,7 +253,7 @@ TEST(OsgBench, OccullRowsInsideOsgMissNoVisibleObjectOverAPath) {
     const auto row = [&](const std::string& name) {
       return *std::find_if(r.summaries.begin(), r.summaries.end(), [&](const auto& s) { return s.name == name; });
     };
-    for (const char* name : {"vfc", "chcpp", "stopwait"}) {
+    for (const char* name : {"vfc", "chcpp", "stopwait", "auto"}) {
       EXPECT_TRUE(row(name).conservative) << name;
       EXPECT_EQ(row(name).missed_objects, 0u) << name << " (" << threading << "): " << row(name).first_miss;
     }
@@ -261,6 +261,12 @@ TEST(OsgBench, OccullRowsInsideOsgMissNoVisibleObjectOverAPath) {
     EXPECT_GT(row("vfc").truth_object_frames, 0u);
     EXPECT_LT(row("stopwait").objects_rendered_per_frame, row("vfc").objects_rendered_per_frame) << threading;
     EXPECT_GT(row("chcpp").queries_per_frame, 0.0);
+    // auto reports what it ran; soc, with no vertex registered by the group, never runs.
+    const auto& choices = row("auto").auto_choices;
+    ASSERT_FALSE(choices.empty()) << threading;
+    const auto soc = std::find_if(choices.begin(), choices.end(), [](const auto& c) { return c.first == "soc"; });
+    ASSERT_NE(soc, choices.end());
+    EXPECT_EQ(soc->second, 0.0) << threading;
   }
 }
 

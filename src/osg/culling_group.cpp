@@ -268,6 +268,7 @@ void OcclusionCullingGroup::draw(::osg::RenderInfo& info) {
   const ::osg::Viewport* vp = state.getCurrentViewport();
   if (vp == nullptr && camera != nullptr) vp = camera->getViewport();
   c.frame = {};
+  c.frame.choices = c.culler->choices();
   c.frame.gather_ms = std::exchange(s.gather_ms, 0.0);  // the first camera drawn after a gather pays for it
   c.backend->begin_frame(info, view_matrix, instances_, s.scene);
   const BackendStats before = c.backend->stats();

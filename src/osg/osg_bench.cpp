@@ -370,6 +370,8 @@ BenchResult run_osg_bench(const OsgBenchConfig& config, const ProgressFn& progre
         run.frames.push_back(stats);
       }
       run.longest_miss_frames = misses.longest();
+      if (graph.group)  // auto's candidates: the report says what it ran
+        if (const CameraFrame* f = graph.group->last_frame(camera)) run.choices = f->choices;
       if (config.last_frame && rep == 0) config.last_frame(row, config.width, config.height, device->read_rgba());
       device->set_scene(nullptr);  // the group hands back its queries, the graph its GL objects
       result.runs.push_back(std::move(run));

@@ -98,6 +98,7 @@ struct CameraFrame {
   std::vector<occull::ObjectId> drawn;  ///< objects drawn (ascending; ids of instances())
   occull::FrameStats culler;            ///< the culler's own counters; cpu_ms: its time outside backend calls, ms
   occull::BackendStats backend;         ///< what the backend counted in the frame (draws, queries, waits, ...)
+  std::vector<std::string> choices;     ///< the culler's Culler::choices(): auto's candidates, in order (culler.auto_choice indexes them from 1)
   /// Time the group spent gathering the graph into its scene this frame
   /// (walk, changes, refit), ms; counted for the first camera drawn after it.
   double gather_ms = 0.0;
