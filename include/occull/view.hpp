@@ -43,6 +43,12 @@ struct View {
   int samples = 1;
 };
 
+/// The projection times the view's rotation, in double: what positions
+/// relative to the eye (world - eye) are projected by. The renderer projects
+/// this way (small numbers near the camera whatever the coordinates' size),
+/// and so does holds_no_sample.
+[[nodiscard]] glm::dmat4 eye_relative_projection(const View& view) noexcept;
+
 /// Exact sub-pixel culling: whether whatever lies in `box` (world space)
 /// makes no fragment in `view`, because the rectangle its 8 corners project
 /// to holds no pixel centre of the viewport. Lossless, unlike a size
@@ -62,12 +68,6 @@ struct View {
 ///     kept (its rectangle means nothing).
 ///  5. A centre on the rectangle's edge is inside (ties keep the box).
 /// Returns false ("may make a fragment") for an empty box too.
-/// The projection times the view's rotation, in double: what positions
-/// relative to the eye (world - eye) are projected by. The renderer projects
-/// this way (small numbers near the camera whatever the coordinates' size),
-/// and so does holds_no_sample.
-[[nodiscard]] glm::dmat4 eye_relative_projection(const View& view) noexcept;
-
 struct SubpixelRules {
   bool grow_for_rounding = true;  ///< rule 2
   bool snapping_margin = true;    ///< rule 3's widening
