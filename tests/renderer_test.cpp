@@ -1,6 +1,7 @@
 // GL integration tests: the reference renderer on llvmpipe (or any GL 4.5
 // driver), small frames.
 #include "gl/gl.hpp"
+#include "gl/renderer_impl.hpp"
 #include "occull/error.hpp"
 #include "occull/gl/context.hpp"
 #include "occull/gl/renderer.hpp"
@@ -128,6 +129,31 @@ TEST_F(RendererTest, ThousandQueriesAllReadBackCorrectly) {
     EXPECT_EQ(r.result(queries[i]) > 0, expect_visible[i]) << "query " << i;
   r.end_frame();
   EXPECT_EQ(r.stats().queries, 1000u);
+}
+
+TEST_F(RendererTest, QueryBoxesPastOneFillOfTheirStreamBufferAreDrawn) {
+  // Frames with queries, then one without, then a query of more boxes than
+  // two fills of the stream buffer (each fill fresh storage): hidden boxes
+  // behind the wall and, last, one beside it.
+  WallScene w;
+  gl::Renderer r(w.scene, small());
+  const Aabb hidden = w.scene.object(WallScene::hidden).bounds, beside = w.scene.object(WallScene::beside).bounds;
+  for (int frame = 0; frame < 3; ++frame) {
+    begin_with_wall(r, w);
+    if (frame != 1) {
+      const Aabb one[] = {beside};
+      EXPECT_GT(r.result(r.issue_query(one)), 0u) << "frame " << frame;
+    }
+    r.end_frame();
+  }
+  begin_with_wall(r, w);
+  std::vector<Aabb> boxes(std::size_t(2 * gl::detail::kBoxCapacity + 5), hidden);
+  EXPECT_EQ(r.result(r.issue_query(boxes)), 0u);
+  boxes.back() = beside;
+  EXPECT_GT(r.result(r.issue_query(boxes)), 0u) << "the last box, in the third fill, is drawn";
+  const Aabb one[] = {beside};
+  EXPECT_GT(r.result(r.issue_query(one)), 0u);
+  r.end_frame();
 }
 
 TEST_F(RendererTest, ResultAvailableTurnsTrueAfterFinish) {

@@ -267,13 +267,11 @@ void Renderer::begin_frame(const View& view) {
   if (g.write_ids) glClearNamedFramebufferuiv(g.fbo, GL_COLOR, 1, zero);
   const float far = g.depth_far();
   glClearNamedFramebufferfv(g.fbo, GL_DEPTH, 0, &far);
-  // Fresh storage for this frame's query boxes (orphaning: the previous
-  // frame's draws keep their copy).
-  glNamedBufferData(g.box_buffer, kBoxCapacity * GLsizeiptr(sizeof(Aabb)), nullptr, GL_STREAM_DRAW);
-  g.box_offset = 0;
-  if (g.indirect_capacity > 0)
-    glNamedBufferData(g.indirect_buffer, g.indirect_capacity, nullptr, GL_STREAM_DRAW);
-  g.indirect_offset = 0;
+  // The query boxes of the last frame stay with its draws: this frame's
+  // first box takes fresh storage (orphaning, in the query's upload), and a
+  // frame without queries takes none (a fill is zeroed by llvmpipe).
+  if (g.box_offset > 0) g.box_offset = kBoxCapacity;
+  if (g.indirect_offset > 0) g.indirect_offset = g.indirect_capacity;  // the same for draw commands
   if (g.timer_supported) glBeginQuery(GL_TIME_ELAPSED, g.timer);
 }
 
