@@ -41,9 +41,18 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 
 namespace occull::detail {
+namespace {
+
+// A frame above this times the lowest of its try, or the current's running
+// cost, is a spike of the machine rather than a cost of the candidate
+// (auto.hpp).
+constexpr double kSpike = 2.0;
+
+}  // namespace
 
 AutoSchedule::AutoSchedule(AutoConfig config, std::size_t candidates)
     : config_(std::move(config)), count_(candidates), cost_(candidates, 0.0), estimate_(candidates, 0.0),
@@ -101,10 +110,21 @@ void AutoSchedule::lost(std::size_t c, std::uint32_t by) {
   next_try_[c] = frame_ + (std::uint64_t(config_.period) << (losses_[c] - 1));  // period x 1, 2, 4, 8, 16
 }
 
-void AutoSchedule::end_trial(bool cut) {
+double AutoSchedule::try_cost() const {
+  if (samples_.empty()) return 0.0;
+  const double lowest = *std::min_element(samples_.begin(), samples_.end());
   double sum = 0.0;
-  for (double s : samples_) sum += s;
-  const double measured = samples_.empty() ? 0.0 : sum / double(samples_.size());
+  int counted = 0;
+  for (double s : samples_)
+    if (s <= kSpike * lowest) {  // above: a spike of the machine, not of the candidate
+      sum += s;
+      ++counted;
+    }
+  return sum / double(counted);
+}
+
+void AutoSchedule::end_trial(bool cut) {
+  const double measured = try_cost();
   const std::size_t c = running_;
   in_trial_ = false;
   if (initial_) {
@@ -186,13 +206,18 @@ void AutoSchedule::finished(double cost) {
   if (in_trial_) {
     samples_.push_back(cost);
     ++trial_frame_;
-    const double against = reference(running_);
-    const bool cut = trial_frame_ == 1 && against > 0.0 && cost > config_.cut * against;
-    if (trial_frame_ >= config_.trial || cut) end_trial(cut);
+    // Lost by far: every frame of the try above cut x the reference; one
+    // frame decides only when it is no spike against the candidate's last
+    // measure (a loser tried again), else two do (the start's round).
+    const double against = reference(running_), lowest = *std::min_element(samples_.begin(), samples_.end());
+    const bool confirmed = trial_frame_ >= 2 || (cost_[running_] > 0.0 && cost <= kSpike * cost_[running_]);
+    const bool cut = confirmed && against > 0.0 && lowest > config_.cut * against;
+    if (trial_frame_ >= config_.trial || cut) end_trial(cut || (against > 0.0 && try_cost() > config_.cut * against));
     return;
   }
-  // The current culler: a running cost, so it follows the scene.
-  cost_[current_] += config_.smoothing * (cost - cost_[current_]);
+  // The current culler: a running cost, so it follows the scene; a spike
+  // counts as kSpike x that cost.
+  cost_[current_] += config_.smoothing * (std::min(cost, kSpike * cost_[current_]) - cost_[current_]);
   choose_next();
 }
 
@@ -210,6 +235,9 @@ constexpr std::uint32_t kWholeSubtree = 8;
 
 // The frustum's exact content is measured every this many frames.
 constexpr std::uint64_t kExactEvery = 8;
+
+// vfc's estimate: the median of the cost per unit drawn of this many last frames.
+constexpr std::size_t kPriceFrames = 5;
 
 // A candidate back after at most this many frames goes on from its own state.
 constexpr std::uint64_t kFreshFrames = 4;
@@ -383,9 +411,13 @@ class AutoCuller final : public Culler {
     const double drawn = double(measured.triangles) + kTrianglesPerDraw * double(measured.draw_calls);
     // (Not from hiz's frames: what the device drew is read back after the frame, if at all.)
     if (measured.frame_ms > 0.0 && drawn > 0.0 && !candidates_[last_].frustum && !candidates_[last_].device) {
-      const double per_unit = std::max(0.0, measured.frame_ms - measured.cpu_ms - measured.wait_ms) / drawn;
+      // The median of the last kPriceFrames frames' price: one frame's spike does not skip vfc's try.
+      prices_[priced_++ % kPriceFrames] = std::max(0.0, measured.frame_ms - measured.cpu_ms - measured.wait_ms) / drawn;
+      std::array<double, kPriceFrames> sorted = prices_;
+      const std::size_t n = std::min<std::size_t>(priced_, kPriceFrames);
+      std::nth_element(sorted.begin(), sorted.begin() + n / 2, sorted.begin() + n);
       for (std::size_t c = 0; c < candidates_.size(); ++c)
-        if (candidates_[c].frustum) schedule_.estimate(c, per_unit * exact_share_);
+        if (candidates_[c].frustum) schedule_.estimate(c, sorted[n / 2] * exact_share_);
     }
     if (after_cut_ > 0)
       schedule_.unmeasured();
@@ -431,6 +463,8 @@ class AutoCuller final : public Culler {
   std::size_t last_ = std::size_t(-1);  // the candidate run in the last frame
   std::uint64_t frame_ = 0;             // frames run, counting from 1
   double own_ms_ = 0.0;
+  std::array<double, kPriceFrames> prices_{};  // the last frames' cost per unit drawn (vfc's estimate)
+  std::size_t priced_ = 0;
   bool awaiting_feedback_ = false;
   bool started_ = false;
 };
@@ -453,7 +487,8 @@ Registration auto_registration() {
                 "a challenger must be this much cheaper to take over (frame times of one culler vary by a few "
                 "percent between frames)")
           .real("cut", &C::cut, 1.0, 100.0,
-                "a try whose first frame costs more than this times the current culler's ends after that frame")
+                "a try costing more than this times the current culler's lost by far (its next try in 4x period "
+                "frames at least)")
           .real("skip", &C::skip, 1.0, 100.0,
                 "vfc is not tried while its estimated cost is above this times the current culler's");
   return registered(

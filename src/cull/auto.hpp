@@ -19,10 +19,10 @@ struct AutoConfig {
   /// hiz only on a backend with device culling (auto.cpp). Not nohc: never
   /// the cheapest there, and its first frame costs 2-3x its later ones.
   std::string candidates = "chc+chcpp+soc+hiz+vfc";
-  int trial = 2;           ///< frames a try runs at most (its cost: their mean)
+  int trial = 2;           ///< frames a try runs (its cost: their mean, spikes left out)
   int period = 40;         ///< frames before a loser's next try; doubled after each further loss, up to 16x
   double margin = 0.08;    ///< a challenger must be this much cheaper than the current to take over (hysteresis)
-  double cut = 1.3;        ///< a try whose first frame costs more than this times the current's cost ends there
+  double cut = 1.3;        ///< a try costing above this times the current's lost by far
   double skip = 1.5;       ///< a challenger estimated above this times the current's cost is not tried (a lost try)
   double smoothing = 0.15; ///< weight of the newest frame in the running cost of the current culler
 };
@@ -36,19 +36,25 @@ struct AutoConfig {
 /// cheapest is kept ("the current"). So with fixed costs the schedule runs
 /// the cheapest from frame 1 + trial x candidates on.
 ///
-/// A try of a challenger runs `trial` frames, or one when that frame costs
-/// more than `cut` x the current's cost: no try costs more than `trial`
-/// frames of a loser, and a loser that costs more than `cut` x the best
-/// costs one frame. A try is skipped (and counts as lost) when the
-/// challenger's estimate (estimate(); auto gives one for vfc, whose frame
-/// is predictable: it draws the frustum) exceeds `skip` x the current's.
-/// The challenger takes over when its try's mean is below (1 - margin) x
-/// the current's running cost; two candidates of equal cost therefore do
-/// not alternate. A challenger that loses waits period frames for its next
-/// try, twice as long after each further loss, up to 16 x period; a try cut
-/// after its first frame, one that lost the start's round by more than
-/// `cut`, or one skipped as hopeless counts as three losses (4 x period at
-/// least). So after the costs change, the cheaper candidate is kept within
+/// A try of a challenger runs `trial` frames, or fewer when every one
+/// costs more than `cut` x the current's: one, when that frame is within
+/// twice the candidate's last measured cost (a loser tried again), else
+/// two. No try costs more than `trial` frames of a loser. Its cost is the
+/// mean of its frames but spikes: a frame above twice the try's lowest is
+/// the machine's (a page fault storm, a descheduled driver thread: measured
+/// on llvmpipe, 4-5 ms frames among 1 ms ones, most in a run's first
+/// frames), not the candidate's. The current's
+/// running cost takes each frame at most at twice its value. A try is
+/// skipped (and counts as lost) when the challenger's estimate (estimate();
+/// auto gives one for vfc, whose frame is predictable: it draws the
+/// frustum) exceeds `skip` x the current's. The challenger takes over when
+/// its try's cost is below (1 - margin) x the current's running cost; two
+/// candidates of equal cost therefore do not alternate. A challenger that
+/// loses waits period frames for its next try, twice as long after each
+/// further loss, up to 16 x period; a try that cost more than `cut` x the
+/// current's (in the start's round too), or one skipped as hopeless, counts
+/// as three losses (4 x period at least). So after the costs change, the
+/// cheaper candidate is kept within
 /// trial + 16 x period frames.
 class AutoSchedule {
  public:
@@ -81,7 +87,8 @@ class AutoSchedule {
 
  private:
   void start_trial(std::size_t c);
-  void end_trial(bool cut);  // cut: after its first frame, which cost more than cut x
+  void end_trial(bool cut);  // cut: the try cost more than cut x the reference (lost by far)
+  [[nodiscard]] double try_cost() const;  // the mean of the try's frames, spikes left out
   void after_initial(std::size_t c);  // the try of candidate c in the initial round ended
   void choose_next();
   void lost(std::size_t c, std::uint32_t by = 1);  // c lost a try (or skipped one): its next comes later
