@@ -293,6 +293,30 @@ TEST(AutoCuller, PredictsEachFramesCostFromItsCandidatesLastMeasure) {
   EXPECT_NEAR(predicted[7], 1.5, 1e-9) << "vfc kept, on the same view: its measured 1.5 ms";
 }
 
+TEST(AutoCuller, APredictionErrorIsCorrectedWithinFifteenFrames) {
+  // vfc is kept (1.5 ms against chcpp's 6); from frame 20 its frames cost
+  // 3 ms. Its prediction follows: the running cost moves by smoothing (15 %)
+  // of the error each frame, so a 50 % error is below 5 % 15 frames later.
+  const Scene scene = test::box_scene({{{-1, -1, -5}, {1, 1, -4}}, {{-1, -1, -9}, {1, 1, -8}}});
+  const Bvh bvh = Bvh::build(scene);
+  Options o;
+  o.set("auto.candidates", "vfc+chcpp");
+  o.set("auto.period", "1000");
+  const auto culler = make_culler("auto", {scene, bvh}, o);
+  const View view = make_view({{0, 0, 0}, 0, 0}, {60.0f, 0.1f, 200.0f}, 64, 64);
+  test::ScriptedBackend backend;
+  for (int k = 0; k < 20 + 15 + 1; ++k) {
+    const FrameStats s = culler->render_frame(view, backend);
+    ASSERT_EQ(s.auto_choice, k == 3 || k == 4 ? 2u : 1u) << "frame " << k;
+    const double measured = s.auto_choice == 2 ? 6.0 : (k < 20 ? 1.5 : 3.0);
+    if (k == 20) EXPECT_NEAR(s.auto_predicted_ms, 1.5, 1e-9) << "the change is not foreseen";
+    if (k == 20 + 15) EXPECT_NEAR(s.auto_predicted_ms, measured, 0.05 * measured) << "corrected within 15 frames";
+    FrameStats m;
+    m.frame_ms = measured;
+    culler->frame_finished(m);
+  }
+}
+
 TEST(AutoCuller, HandsOverTheVisibleSetTheQueryCullersTakeAsTheirLastFrames) {
   std::vector<Aabb> boxes;
   for (int i = 0; i < 12; ++i) boxes.push_back({{-1.0f, -1.0f, -5.0f - 3.0f * float(i)}, {1.0f, 1.0f, -4.0f - 3.0f * float(i)}});
