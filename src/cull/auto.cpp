@@ -32,6 +32,24 @@
 //   - soc and vfc keep no state across frames: nothing to keep warm.
 //   - What a switch still costs is priced in: every frame a candidate runs
 //     is measured, the first one of a try included.
+//
+// The model, and where it fails. A candidate's cost is one number: its
+// frame time per unit of frame content (FrustumContent below), from the
+// frames it ran; the running one's is corrected every frame (smoothing),
+// the others' are their last try's. The prediction of a frame is that
+// number times the frame's content. It fails:
+//   - where the occluded share of the frustum changes along the path: the
+//     content counts the frustum, not what hides what, so a try on an open
+//     stretch and the current's cost in a street are not alike (spread
+//     frames: `city:blocks=20` at 1280x720 kept soc at 1.21x chcpp);
+//   - in a try's two frames, which are few against the machine's noise
+//     (spikes are left out, AutoSchedule; drift of 10-30 % is not);
+//   - for a candidate's first frames: start-up (hiz compiles its compute
+//     programs at the renderer's first device frame, 5-8 ms on llvmpipe)
+//     and a cold state (CHC's first frame queries everything) count as its
+//     cost, unless the frame is more than twice the try's other (a spike);
+//   - for vfc's estimate, which counts every fixed cost of the frame as
+//     drawing and so errs high: it only skips tries, never switches.
 #include "auto.hpp"
 
 #include "cullers.hpp"
