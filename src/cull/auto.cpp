@@ -44,8 +44,8 @@
 //     frames: `city:blocks=20` at 1280x720 kept soc at 1.21x chcpp);
 //   - in a try's two frames, which are few against the machine's noise
 //     (spikes are left out, AutoSchedule; drift of 10-30 % is not);
-//   - for a candidate's first frames: start-up (hiz compiles its compute
-//     programs at the renderer's first device frame, 5-8 ms on llvmpipe)
+//   - for a candidate's first frames: start-up (the renderer creates its
+//     device state at its first hiz frame: 9-13 ms on llvmpipe, small maps)
 //     and a cold state (CHC's first frame queries everything) count as its
 //     cost, unless the frame is more than twice the try's other (a spike);
 //   - for vfc's estimate, which counts every fixed cost of the frame as
