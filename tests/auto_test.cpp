@@ -195,6 +195,18 @@ TEST(AutoSchedule, ADisabledCandidateNeverRuns) {
   for (std::size_t k = 50; k < ran.size(); ++k) EXPECT_EQ(ran[k], 2u) << "frame " << k;
 }
 
+TEST(AutoSchedule, ACurrentNeverMeasuredIsMeasuredFromItsFirstFrame) {
+  detail::AutoSchedule s(config(), 3);
+  s.estimate(2, 100.0);  // candidate 2 is skipped as hopeless: never measured
+  run(s, {1.0, 2.0, 3.0}, 8);
+  ASSERT_EQ(s.cost(2), 0.0);
+  s.disable(0);
+  s.disable(1);  // only candidate 2 is left, its cost unknown
+  ASSERT_EQ(s.current(), 2u);
+  run(s, {1.0, 2.0, 3.0}, 1);
+  EXPECT_DOUBLE_EQ(s.cost(2), 3.0);
+}
+
 TEST(AutoSchedule, AnUnmeasuredFrameIsNotCounted) {
   detail::AutoSchedule s(config(), 2);
   s.finished(1.0);  // the uncounted first frame: candidate 0's try comes next

@@ -234,8 +234,10 @@ void AutoSchedule::finished(double cost) {
     return;
   }
   // The current culler: a running cost, so it follows the scene; a spike
-  // counts as kSpike x that cost.
-  cost_[current_] += config_.smoothing * (std::min(cost, kSpike * cost_[current_]) - cost_[current_]);
+  // counts as kSpike x that cost. Never measured (kept because every other
+  // was disabled), it starts from this frame.
+  double& running = cost_[current_];
+  running = running > 0.0 ? running + config_.smoothing * (std::min(cost, kSpike * running) - running) : cost;
   choose_next();
 }
 
