@@ -141,7 +141,7 @@ double AutoSchedule::try_cost() const {
   return sum / double(counted);
 }
 
-void AutoSchedule::end_trial(bool cut) {
+void AutoSchedule::end_trial() {
   const double measured = try_cost();
   const std::size_t c = running_;
   in_trial_ = false;
@@ -158,8 +158,9 @@ void AutoSchedule::end_trial(bool cut) {
     ++switches_;
     switched_ = true;
   } else {
+    const bool by_far = cost_[current_] > 0.0 && measured > config_.cut * cost_[current_];
     cost_[c] = measured;
-    lost(c, cut ? 3 : 1);  // lost by far: as three lost tries (its next in 4 x period frames at least)
+    lost(c, by_far ? 3 : 1);  // lost by far: as three lost tries (its next in 4 x period frames at least)
   }
   running_ = current_;
 }
@@ -230,7 +231,7 @@ void AutoSchedule::finished(double cost) {
     const double against = reference(running_), lowest = *std::min_element(samples_.begin(), samples_.end());
     const bool confirmed = trial_frame_ >= 2 || (cost_[running_] > 0.0 && cost <= kSpike * cost_[running_]);
     const bool cut = confirmed && against > 0.0 && lowest > config_.cut * against;
-    if (trial_frame_ >= config_.trial || cut) end_trial(cut || (against > 0.0 && try_cost() > config_.cut * against));
+    if (trial_frame_ >= config_.trial || cut) end_trial();
     return;
   }
   // The current culler: a running cost, so it follows the scene; a spike

@@ -87,7 +87,7 @@ class AutoSchedule {
 
  private:
   void start_trial(std::size_t c);
-  void end_trial(bool cut);  // cut: the try cost more than cut x the reference (lost by far)
+  void end_trial();  // a try that cost more than cut x the current's lost by far
   [[nodiscard]] double try_cost() const;  // the mean of the try's frames, spikes left out
   void after_initial(std::size_t c);  // the try of candidate c in the initial round ended
   void choose_next();
