@@ -45,6 +45,16 @@ TEST(AutoSchedule, TriesEveryCandidateAfterAnUncountedFirstFrameThenKeepsTheChea
   EXPECT_EQ(s.next(), 1u);
 }
 
+TEST(AutoSchedule, AFirstCandidateWithoutStateIsMeasuredFromItsFirstFrame) {
+  detail::AutoSchedule s(config(), 3);
+  s.no_cold_frame();
+  EXPECT_TRUE(s.starts_try());
+  const auto ran = run(s, {5.0, 2.0, 2.4}, 6);
+  EXPECT_EQ(ran, (std::vector<std::size_t>{0, 0, 1, 1, 2, 2})) << "no uncounted frame: a try of two frames each";
+  EXPECT_EQ(s.current(), 1u);
+  EXPECT_EQ(s.cost(0), 5.0) << "its first frame measured";
+}
+
 TEST(AutoSchedule, ATryAboveCutTimesTheBestIsLostByFar) {
   const detail::AutoConfig c = config();
   detail::AutoSchedule s(c, 3);
@@ -184,6 +194,27 @@ TEST(AutoSchedule, AChallengerEstimatedAboveSkipTimesTheCurrentIsNeverTried) {
   EXPECT_EQ(s.tries(), 1u);  // candidate 0's measure at the start only
 }
 
+TEST(AutoSchedule, AnEstimateOfThisFrameBelowTheCurrentByTheMarginTakesOverWithoutATry) {
+  detail::AutoSchedule s(config(), 2);  // margin 5 %
+  (void)run(s, {1.0, 1.2}, 5);          // the start's round: 0 kept, 1 lost (its next try in period frames)
+  ASSERT_EQ(s.current(), 0u);
+  const std::uint64_t tries = s.tries();
+  s.estimate(1, 0.97);  // within the margin
+  s.finished(1.0);
+  EXPECT_EQ(s.next(), 0u);
+  s.estimate(1, 0.9);  // given with a frame that measured nothing: stale at the next
+  s.unmeasured();
+  s.finished(1.0);
+  EXPECT_EQ(s.next(), 0u) << "an older estimate only skips tries";
+  s.estimate(1, 0.9);
+  s.finished(1.0);
+  EXPECT_EQ(s.next(), 1u);
+  EXPECT_EQ(s.current(), 1u);
+  EXPECT_TRUE(s.just_switched());
+  EXPECT_EQ(s.tries(), tries) << "no try";
+  EXPECT_EQ(s.cost(1), 0.9) << "its running cost starts from the estimate";
+}
+
 TEST(AutoSchedule, ADisabledCandidateNeverRuns) {
   detail::AutoSchedule s(config(), 3);
   s.disable(0);  // before the first frame
@@ -279,9 +310,10 @@ TEST(AutoCuller, RecordsTheCandidateOfEachFrameAndItsTries) {
     measured.frame_ms = s.auto_choice == 1 ? 1.0 : 3.0;  // vfc is cheaper
     culler->frame_finished(measured);
   }
-  // The uncounted first frame and vfc's try (2 frames), chcpp's try (2 frames), then vfc kept.
-  EXPECT_EQ(choice, (std::vector<std::uint32_t>{1, 1, 1, 2, 2, 1}));
-  EXPECT_EQ(tries, (std::vector<std::uint64_t>{0, 1, 0, 1, 0, 0}));
+  // vfc's try (2 frames; it keeps no state, so its first frame is no cold
+  // one and is measured), chcpp's try (2 frames), then vfc kept.
+  EXPECT_EQ(choice, (std::vector<std::uint32_t>{1, 1, 2, 2, 1, 1}));
+  EXPECT_EQ(tries, (std::vector<std::uint64_t>{1, 0, 1, 0, 0, 0}));
 }
 
 TEST(AutoCuller, PredictsEachFramesCostFromItsCandidatesLastMeasure) {
@@ -319,7 +351,7 @@ TEST(AutoCuller, APredictionErrorIsCorrectedWithinFifteenFrames) {
   test::ScriptedBackend backend;
   for (int k = 0; k < 20 + 15 + 1; ++k) {
     const FrameStats s = culler->render_frame(view, backend);
-    ASSERT_EQ(s.auto_choice, k == 3 || k == 4 ? 2u : 1u) << "frame " << k;
+    ASSERT_EQ(s.auto_choice, k == 2 || k == 3 ? 2u : 1u) << "frame " << k;
     const double measured = s.auto_choice == 2 ? 6.0 : (k < 20 ? 1.5 : 3.0);
     if (k == 20) EXPECT_NEAR(s.auto_predicted_ms, 1.5, 1e-9) << "the change is not foreseen";
     if (k == 20 + 15) EXPECT_NEAR(s.auto_predicted_ms, measured, 0.05 * measured) << "corrected within 15 frames";
@@ -398,15 +430,15 @@ View looking_down_z(glm::vec3 eye, float yaw_degrees = 0.0f) {
 }  // namespace
 
 TEST(AutoCuller, AFrameAfterACameraCutIsNotMeasured) {
-  // A jump to the other side of the row as chcpp's try begins (frame 3):
-  // the cut's frame and the next cost 20x (every culler starts over there)
-  // and are not held against it.
-  const auto cost = [](std::uint32_t c, int k) { return k == 3 || k == 4 ? 20.0 : (c == 1 ? 2.0 : 1.0); };
-  const auto view_of = [](int k) { return k < 3 ? looking_down_z({0, 0, 0}) : looking_down_z({0, 0, -40}, 180.0f); };
+  // A jump to the other side of the row as chcpp's try begins (frame 2,
+  // after vfc's two): the cut's frame and the next cost 20x (every culler
+  // starts over there) and are not held against it.
+  const auto cost = [](std::uint32_t c, int k) { return k == 2 || k == 3 ? 20.0 : (c == 1 ? 2.0 : 1.0); };
+  const auto view_of = [](int k) { return k < 2 ? looking_down_z({0, 0, 0}) : looking_down_z({0, 0, -40}, 180.0f); };
   const auto choice = auto_frames(cost, view_of, 12);
   EXPECT_EQ(choice.back(), 2u) << "chcpp, measured after the cut, is kept";
   // Broken on purpose (a walk, not a jump): the same costs, the view turned 1 degree.
-  const auto walk = auto_frames(cost, [](int k) { return looking_down_z({0, 0, 0}, k < 3 ? 0.0f : 1.0f); }, 12);
+  const auto walk = auto_frames(cost, [](int k) { return looking_down_z({0, 0, 0}, k < 2 ? 0.0f : 1.0f); }, 12);
   EXPECT_EQ(walk.back(), 1u) << "without a cut the expensive frames count and chcpp's try is lost by far";
 }
 
@@ -429,4 +461,49 @@ TEST(AutoCuller, ACpuOcclusionBufferIsNoCandidateWithoutVertices) {
     measured.frame_ms = s.auto_choice == 1 ? 1.0 : 5.0;
     culler->frame_finished(measured);
   }
+}
+
+TEST(AutoCuller, TheStartsRoundOpensWithTheCpuBufferWhereItCanOccludeElseWithChc) {
+  // By default: soc first (no state to build, so no cold frame: its try is
+  // its first two frames; the query cullers after it start from its visible
+  // set); where no mesh has CPU vertices soc cannot occlude and chc opens
+  // instead, with an uncounted cold frame before its try.
+  const auto first_three = [](const Scene& scene) {
+    const Bvh bvh = Bvh::build(scene);
+    const auto culler = make_culler("auto", {scene, bvh});
+    EXPECT_EQ(culler->choices().front(), "soc") << "the default candidates, in their order";
+    test::ScriptedBackend backend;
+    std::vector<std::string> ran;
+    for (int k = 0; k < 3; ++k) {
+      const FrameStats s = culler->render_frame(looking_down_z({0, 0, 0}), backend);
+      ran.push_back(culler->choices()[s.auto_choice - 1]);
+      FrameStats measured;
+      measured.frame_ms = 1.0;
+      culler->frame_finished(measured);
+    }
+    return ran;
+  };
+  std::vector<Aabb> boxes;
+  for (int i = 0; i < 4; ++i) boxes.push_back({{-1.0f, -1.0f, -5.0f - 3.0f * float(i)}, {1.0f, 1.0f, -4.0f - 3.0f * float(i)}});
+  EXPECT_EQ(first_three(test::box_scene(boxes)), (std::vector<std::string>{"soc", "soc", "chc"}));
+  Scene no_vertices;
+  const MaterialId m = no_vertices.add_material({});
+  const MeshId mesh = no_vertices.add_mesh(MeshInfo{{{-1, -1, -1}, {1, 1, 1}}, 12, 24.0});
+  for (int i = 0; i < 4; ++i)
+    (void)no_vertices.add_object(mesh, m, glm::translate(glm::mat4(1.0f), glm::vec3(0, 0, -5.0f - 3.0f * float(i))),
+                                 OccluderClass::always);
+  EXPECT_EQ(first_three(no_vertices), (std::vector<std::string>{"chc", "chc", "chc"}));
+}
+
+TEST(AutoCuller, AViewThatJumpsEveryFrameIsMeasuredFromItsNinthJumpOn) {
+  // Frames spread over a path: the view jumps between two ends of the row
+  // every frame. chcpp is cheaper; vfc, the first candidate, runs until
+  // frames are measured again.
+  const auto cost = [](std::uint32_t c, int) { return c == 1 ? 2.0 : 1.0; };
+  const auto jumping = [](int k) { return k % 2 == 0 ? looking_down_z({0, 0, 0}) : looking_down_z({0, 0, -40}, 180.0f); };
+  const auto choice = auto_frames(cost, jumping, 30);
+  EXPECT_TRUE(std::all_of(choice.begin(), choice.begin() + 10, [](std::uint32_t c) { return c == 1; }))
+      << "a cut's frame and the next are not measured until eight cuts in a row (frame 9), so the start's round "
+         "waits";
+  EXPECT_EQ(choice.back(), 2u) << "jumps are how this view moves: measured, chcpp is kept";
 }

@@ -9,16 +9,20 @@
 namespace occull::detail {
 
 struct AutoConfig {
-  /// Candidates, joined by +, tried in this order at the start (chc first:
-  /// from nothing it settles in one frame, CHC++ in several, and the next
-  /// ones start from its visible set; measured, CHC++ first left a large
-  /// city's round measuring everything against its unsettled frames, 2.2x
-  /// the best at 320x180; the price of chc first is its frames on open
-  /// ground, up to 4x vfc's at 1280x720). By default every conservative culler
-  /// that was the cheapest on some entry of `occull bench --suite default`;
-  /// hiz only on a backend with device culling (auto.cpp). Not nohc: never
-  /// the cheapest there, and its first frame costs 2-3x its later ones.
-  std::string candidates = "chc+chcpp+soc+hiz+vfc";
+  /// Candidates, joined by +, tried in this order at the start. soc first:
+  /// it keeps no state across frames, so its first frame is already a
+  /// settled one and costs about vfc's where it occludes little, and the
+  /// query cullers after it start from its visible set (hand-over) instead
+  /// of from nothing (CHC's cold first frame queries every node: 343 ms
+  /// against vfc's 70 on field at 1280x720); where soc cannot run (no CPU
+  /// vertices, OpenSceneGraph's group) chc opens, which settles in one
+  /// frame where CHC++ takes several (CHC++ first left a large city's round
+  /// measuring everything against its unsettled frames, 2.2x the best at
+  /// 320x180). By default every conservative culler that was the cheapest
+  /// on some entry of `occull bench --suite default`; hiz only on a backend
+  /// with device culling (auto.cpp). Not nohc: never the cheapest there,
+  /// and its first frame costs 2-3x its later ones.
+  std::string candidates = "soc+chc+chcpp+hiz+vfc";
   int trial = 2;           ///< frames a try runs (its cost: their mean, spikes left out)
   int period = 40;         ///< frames before a loser's next try; doubled after each further loss, up to 16x
   double margin = 0.08;    ///< a challenger must be this much cheaper than the current to take over (hysteresis)
@@ -31,8 +35,9 @@ struct AutoConfig {
 /// run so far (any unit, the same for every frame; auto passes
 /// milliseconds per unit of frame content).
 ///
-/// Start: the first frame runs candidate 0 and is not counted (every
-/// culler starts cold); then each candidate is tried in order, and the
+/// Start: the first frame runs candidate 0 and is not counted (a temporal
+/// culler starts cold; no_cold_frame() says candidate 0 does not, and its
+/// try begins there); then each candidate is tried in order, and the
 /// cheapest is kept ("the current"). So with fixed costs the schedule runs
 /// the cheapest from frame 1 + trial x candidates on.
 ///
@@ -47,7 +52,10 @@ struct AutoConfig {
 /// running cost takes each frame at most at twice its value. A try is
 /// skipped (and counts as lost) when the challenger's estimate (estimate();
 /// auto gives one for vfc, whose frame is predictable: it draws the
-/// frustum) exceeds `skip` x the current's. The challenger takes over when
+/// frustum) exceeds `skip` x the current's; an estimate below (1 - margin)
+/// x the current's running cost takes over without a try (an estimate is
+/// given only where it errs high: below the current's cost by the margin,
+/// the candidate is cheaper). The challenger takes over when
 /// its try's cost is below (1 - margin) x the current's running cost; two
 /// candidates of equal cost therefore do not alternate. A challenger that
 /// loses waits period frames for its next try, twice as long after each
@@ -74,10 +82,15 @@ class AutoSchedule {
   /// cut: every temporal culler starts over there): it is not counted; a try
   /// in progress goes on and is judged on its measured frames.
   void unmeasured();
+  /// The first frame's candidate keeps no state across frames (soc, vfc):
+  /// its first frame is measured like any other, the first of its try.
+  /// Call before the first finished(); after disable() of the first.
+  void no_cold_frame();
   /// Never runs candidate `c` again (it cannot run here: hiz on a backend
   /// without device culling). Precondition: some other candidate remains.
   void disable(std::size_t c);
-  /// An estimate of candidate `c`'s cost now, in finished()'s unit (0: none).
+  /// An estimate of candidate `c`'s cost now, in finished()'s unit (0:
+  /// none). Precondition: it errs high, if at all (it may switch to `c`).
   void estimate(std::size_t c, double cost);
 
   [[nodiscard]] std::size_t current() const noexcept { return current_; }  ///< the one kept between tries
@@ -91,6 +104,8 @@ class AutoSchedule {
   [[nodiscard]] double try_cost() const;  // the mean of the try's frames, spikes left out
   void after_initial(std::size_t c);  // the try of candidate c in the initial round ended
   void choose_next();
+  void take_over(std::size_t c, double cost);  // c becomes the current, at this cost
+  [[nodiscard]] std::size_t estimated_cheaper() const;  // the candidate estimated below the current by the margin, or count_
   void lost(std::size_t c, std::uint32_t by = 1);  // c lost a try (or skipped one): its next comes later
   [[nodiscard]] double reference(std::size_t c) const;  // the cost a try of c is measured against
   [[nodiscard]] bool hopeless(std::size_t c) const;  // its estimate skips its try
@@ -99,6 +114,7 @@ class AutoSchedule {
   std::size_t count_;
   std::vector<double> cost_;       // running cost of the current one; last try's mean of the others
   std::vector<double> estimate_;   // 0: none
+  std::vector<std::uint64_t> estimated_in_;  // the frame whose measure the estimate came with
   std::vector<std::uint32_t> losses_;
   std::vector<std::uint64_t> next_try_;
   std::vector<bool> disabled_;
