@@ -187,7 +187,7 @@ TEST(AutoSchedule, KeepsTheCurrentWithinTheMargin) {
 TEST(AutoSchedule, AChallengerEstimatedAboveSkipTimesTheCurrentIsNeverTried) {
   detail::AutoSchedule s(config(), 2);
   for (int k = 0; k < 1000; ++k) {
-    s.estimate(1, 5.0);  // candidate 1 would cost 5: more than skip (1.5) x 2
+    s.estimate(1, 5.0, true);  // candidate 1 would cost 5: more than skip (1.5) x 2
     ASSERT_EQ(s.next(), 0u) << "frame " << k;
     s.finished(2.0);
   }
@@ -199,14 +199,20 @@ TEST(AutoSchedule, AnEstimateOfThisFrameBelowTheCurrentByTheMarginTakesOverWitho
   (void)run(s, {1.0, 1.2}, 5);          // the start's round: 0 kept, 1 lost (its next try in period frames)
   ASSERT_EQ(s.current(), 0u);
   const std::uint64_t tries = s.tries();
-  s.estimate(1, 0.97);  // within the margin
+  s.estimate(1, 0.97, true);  // within the margin
   s.finished(1.0);
   EXPECT_EQ(s.next(), 0u);
-  s.estimate(1, 0.9);  // given with a frame that measured nothing: stale at the next
+  s.estimate(1, 0.9, true);  // given with a frame that measured nothing: stale at the next
   s.unmeasured();
   s.finished(1.0);
   EXPECT_EQ(s.next(), 0u) << "an older estimate only skips tries";
-  s.estimate(1, 0.9);
+  s.estimate(1, 0.9, false);  // not of this frame's view
+  s.finished(1.0);
+  EXPECT_EQ(s.next(), 0u) << "an estimate of another view only skips tries";
+  s.estimate(1, 0.9, true);
+  s.finished(0.9);
+  EXPECT_EQ(s.next(), 0u) << "the current's cost of this same view is below it";
+  s.estimate(1, 0.9, true);
   s.finished(1.0);
   EXPECT_EQ(s.next(), 1u);
   EXPECT_EQ(s.current(), 1u);
@@ -228,7 +234,7 @@ TEST(AutoSchedule, ADisabledCandidateNeverRuns) {
 
 TEST(AutoSchedule, ACurrentNeverMeasuredIsMeasuredFromItsFirstFrame) {
   detail::AutoSchedule s(config(), 3);
-  s.estimate(2, 100.0);  // candidate 2 is skipped as hopeless: never measured
+  s.estimate(2, 100.0, true);  // candidate 2 is skipped as hopeless: never measured
   run(s, {1.0, 2.0, 3.0}, 8);
   ASSERT_EQ(s.cost(2), 0.0);
   s.disable(0);
@@ -442,13 +448,24 @@ TEST(AutoCuller, AFrameAfterACameraCutIsNotMeasured) {
   EXPECT_EQ(walk.back(), 1u) << "without a cut the expensive frames count and chcpp's try is lost by far";
 }
 
-TEST(AutoCuller, ACpuOcclusionBufferIsNoCandidateWithoutVertices) {
+namespace {
+
+// Four boxes in a row down -Z, their mesh registered by MeshInfo alone (no
+// vertex on the CPU), as OpenSceneGraph's group registers meshes.
+Scene scene_without_vertices() {
   Scene scene;
   const MaterialId m = scene.add_material({});
   const MeshId mesh = scene.add_mesh(MeshInfo{{{-1, -1, -1}, {1, 1, 1}}, 12, 24.0});
   for (int i = 0; i < 4; ++i)
     (void)scene.add_object(mesh, m, glm::translate(glm::mat4(1.0f), glm::vec3(0, 0, -5.0f - 3.0f * float(i))),
                            OccluderClass::always);
+  return scene;
+}
+
+}  // namespace
+
+TEST(AutoCuller, ACpuOcclusionBufferIsNoCandidateWithoutVertices) {
+  const Scene scene = scene_without_vertices();
   const Bvh bvh = Bvh::build(scene);
   Options o;
   o.set("auto.candidates", "soc+vfc");
@@ -486,13 +503,7 @@ TEST(AutoCuller, TheStartsRoundOpensWithTheCpuBufferWhereItCanOccludeElseWithChc
   std::vector<Aabb> boxes;
   for (int i = 0; i < 4; ++i) boxes.push_back({{-1.0f, -1.0f, -5.0f - 3.0f * float(i)}, {1.0f, 1.0f, -4.0f - 3.0f * float(i)}});
   EXPECT_EQ(first_three(test::box_scene(boxes)), (std::vector<std::string>{"soc", "soc", "chc"}));
-  Scene no_vertices;
-  const MaterialId m = no_vertices.add_material({});
-  const MeshId mesh = no_vertices.add_mesh(MeshInfo{{{-1, -1, -1}, {1, 1, 1}}, 12, 24.0});
-  for (int i = 0; i < 4; ++i)
-    (void)no_vertices.add_object(mesh, m, glm::translate(glm::mat4(1.0f), glm::vec3(0, 0, -5.0f - 3.0f * float(i))),
-                                 OccluderClass::always);
-  EXPECT_EQ(first_three(no_vertices), (std::vector<std::string>{"chc", "chc", "chc"}));
+  EXPECT_EQ(first_three(scene_without_vertices()), (std::vector<std::string>{"chc", "chc", "chc"}));
 }
 
 TEST(AutoCuller, AViewThatJumpsEveryFrameIsMeasuredFromItsNinthJumpOn) {

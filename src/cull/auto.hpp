@@ -52,10 +52,11 @@ struct AutoConfig {
 /// running cost takes each frame at most at twice its value. A try is
 /// skipped (and counts as lost) when the challenger's estimate (estimate();
 /// auto gives one for vfc, whose frame is predictable: it draws the
-/// frustum) exceeds `skip` x the current's; an estimate below (1 - margin)
-/// x the current's running cost takes over without a try (an estimate is
-/// given only where it errs high: below the current's cost by the margin,
-/// the candidate is cheaper). The challenger takes over when
+/// frustum) exceeds `skip` x the current's; an estimate of this frame's
+/// view below (1 - margin) x the current's cost of the same frame (and its
+/// running cost) takes over without a try (such an estimate errs high:
+/// below the current's cost by the margin, the candidate is cheaper). The
+/// challenger takes over when
 /// its try's cost is below (1 - margin) x the current's running cost; two
 /// candidates of equal cost therefore do not alternate. A challenger that
 /// loses waits period frames for its next try, twice as long after each
@@ -89,9 +90,13 @@ class AutoSchedule {
   /// Never runs candidate `c` again (it cannot run here: hiz on a backend
   /// without device culling). Precondition: some other candidate remains.
   void disable(std::size_t c);
-  /// An estimate of candidate `c`'s cost now, in finished()'s unit (0:
-  /// none). Precondition: it errs high, if at all (it may switch to `c`).
-  void estimate(std::size_t c, double cost);
+  /// An estimate of candidate `c`'s cost of the frame finished() counts
+  /// next, in finished()'s unit (0: none). `of_this_view`: made from this
+  /// frame's view (it may then switch to `c` when below (1 - margin) x both
+  /// the current's running cost and its cost of this frame; otherwise, or
+  /// later, it only skips tries). Precondition: an estimate of this view
+  /// errs high, if at all.
+  void estimate(std::size_t c, double cost, bool of_this_view);
 
   [[nodiscard]] std::size_t current() const noexcept { return current_; }  ///< the one kept between tries
   [[nodiscard]] std::uint64_t switches() const noexcept { return switches_; }
@@ -105,7 +110,8 @@ class AutoSchedule {
   void after_initial(std::size_t c);  // the try of candidate c in the initial round ended
   void choose_next();
   void take_over(std::size_t c, double cost);  // c becomes the current, at this cost
-  [[nodiscard]] std::size_t estimated_cheaper() const;  // the candidate estimated below the current by the margin, or count_
+  // the candidate estimated for this frame below `than` x (1 - margin), or count_
+  [[nodiscard]] std::size_t estimated_cheaper(double than) const;
   void lost(std::size_t c, std::uint32_t by = 1);  // c lost a try (or skipped one): its next comes later
   [[nodiscard]] double reference(std::size_t c) const;  // the cost a try of c is measured against
   [[nodiscard]] bool hopeless(std::size_t c) const;  // its estimate skips its try
