@@ -39,7 +39,8 @@ struct AutoConfig {
 /// culler starts cold; no_cold_frame() says candidate 0 does not, and its
 /// try begins there); then each candidate is tried in order, and the
 /// cheapest is kept ("the current"). So with fixed costs the schedule runs
-/// the cheapest from frame 1 + trial x candidates on.
+/// the cheapest from frame 1 + trial x candidates on (trial x candidates
+/// after no_cold_frame()).
 ///
 /// A try of a challenger runs `trial` frames, or fewer when every one
 /// costs more than `cut` x the current's: one, when that frame is within
