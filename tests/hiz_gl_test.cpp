@@ -276,3 +276,52 @@ TEST_F(Hiz, ReleaseHandsBackTheCullersVisibility) {
   hiz->release(r);  // twice is harmless
   EXPECT_EQ(r.resources().buffers, holding - 1);
 }
+
+TEST_F(Hiz, TheVisibilityReadBackIsWhatPhaseTwoFoundVisibleOrWhatWasSet) {
+  WallScene w;
+  gl::Renderer r(w.scene, target());
+  auto hiz = make_culler("hiz", {w.scene, w.bvh});
+  for (int f = 0; f < 3; ++f) (void)frame(*hiz, r, w.scene, w.view);
+  auto* resumable = dynamic_cast<detail::Resumable*>(hiz.get());
+  ASSERT_NE(resumable, nullptr);
+  std::vector<ObjectId> visible;
+  resumable->last_visible(r, visible);
+  EXPECT_EQ(visible, (std::vector<ObjectId>{WallScene::wall, WallScene::beside})) << "the box behind the wall is hidden";
+  const DeviceCulling::Visibility v = r.create_visibility();
+  const std::vector<ObjectId> set{WallScene::hidden};
+  r.set_visible(v, set);
+  visible.clear();
+  r.read_visible(v, visible);
+  EXPECT_EQ(visible, set);
+  r.destroy_visibility(v);
+  hiz->release(r);
+}
+
+// auto's switch from hiz to a query culler hands over hiz's visible set,
+// read back from the device: the query culler's first frame draws what hiz
+// found visible without querying it, and queries only what hiz found hidden
+// (started cold, it queries every leaf: 3 here).
+TEST_F(Hiz, AutoHandsHizsVisibleSetToTheQueryCullerItTriesNext) {
+  WallScene w;
+  gl::Renderer r(w.scene, target());
+  Options options;
+  options.set("chcpp.virtual_leaf=0");  // one object per leaf: the scene is one virtual leaf otherwise
+  auto culler = make_culler("auto:candidates=hiz+chcpp", {w.scene, w.bvh}, options);
+  bool tried = false;
+  for (int f = 0; f < 12 && !tried; ++f) {
+    RecordingBackend recorder(r, w.scene);
+    r.begin_frame(w.view);
+    recorder.start_frame();
+    const FrameStats s = culler->render_frame(w.view, recorder);
+    r.end_frame();
+    recorder.finish_frame([&](QueryId q) { return r.unread_result(q); });
+    if (s.auto_choice != 2) continue;  // hiz's frames
+    tried = true;
+    std::vector<ObjectId> drawn(recorder.objects().begin(), recorder.objects().end());
+    std::sort(drawn.begin(), drawn.end());
+    EXPECT_EQ(drawn, (std::vector<ObjectId>{WallScene::wall, WallScene::beside}));
+    EXPECT_EQ(recorder.stats().queries, 1u) << "chcpp's first frame queries only the box hiz found hidden";
+  }
+  EXPECT_TRUE(tried) << "auto never tried chcpp";
+  culler->release(r);
+}

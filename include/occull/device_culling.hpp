@@ -63,6 +63,12 @@ class DeviceCulling {
   /// over another's visibility (auto's hand-over). Ids past the scene are
   /// ignored. Precondition: v from create_visibility(), not yet destroyed.
   virtual void set_visible(Visibility v, std::span<const ObjectId> visible) = 0;
+  /// Appends to `out`, ascending, the objects whose bit is set in `v`: what
+  /// the last draw_newly_visible(v) found visible (or set_visible() set), for
+  /// a culler handing its visibility over to another (auto's switch from
+  /// `hiz` to a query culler). Reads the device's buffer back: it waits for
+  /// the device. Precondition: v from create_visibility(), not yet destroyed.
+  virtual void read_visible(Visibility v, std::vector<ObjectId>& out) = 0;
   /// Phase 1: draws every opaque object in the frustum whose bit is set in
   /// `v` (those found visible by the last draw_newly_visible(v)). Writes
   /// depth (and whatever else render() writes).

@@ -72,6 +72,7 @@ class RecordingBackend final : public Backend, private DeviceCulling {
   void build_depth_pyramid() override;
   void draw_newly_visible(Visibility v, int texels) override;
   DeviceCullingTimes read_drawn(std::vector<ObjectId>& out) override { return inner_.device_culling()->read_drawn(out); }
+  void read_visible(Visibility v, std::vector<ObjectId>& out) override { inner_.device_culling()->read_visible(v, out); }
   void set_visible(Visibility v, std::span<const ObjectId> visible) override {
     inner_.device_culling()->set_visible(v, visible);
   }

@@ -32,6 +32,11 @@ Registration tiles_registration();
 class Resumable {
  public:
   virtual void resume_from(std::span<const ObjectId> drawn) = 0;
+  /// For handing over from this culler when drawn_objects() is empty because
+  /// its visible set is elsewhere (hiz: on the device): appends the visible
+  /// set of its last frame to `out`, through `backend` (a read-back that
+  /// waits for the device). Default: nothing (drawn_objects() holds it).
+  virtual void last_visible(Backend& backend, std::vector<ObjectId>& out) { (void)backend, (void)out; }
 
  protected:
   ~Resumable() = default;

@@ -15,7 +15,8 @@
 // Visibility on the device, created on its first frame and handed back by
 // release(). The objects it drew are on the device: drawn_objects() is
 // empty for it; instruments read them back (RecordingBackend does, after the
-// timed frame).
+// timed frame), and auto reads its visibility back when it hands over to
+// another culler (last_visible).
 #include "cullers.hpp"
 
 #include "occull/device_culling.hpp"
@@ -49,6 +50,11 @@ class HizCuller final : public Culler, public Resumable {
   void resume_from(std::span<const ObjectId> drawn) override {
     handed_over_.assign(drawn.begin(), drawn.end());
     resume_ = true;
+  }
+
+  // What phase 2 of its last frame found visible, read from the device.
+  void last_visible(Backend& backend, std::vector<ObjectId>& out) override {
+    if (visibility_) device_of(backend).read_visible(*visibility_, out);
   }
 
   void release(Backend& backend) override {

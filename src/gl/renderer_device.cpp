@@ -492,6 +492,19 @@ void Renderer::set_visible(Visibility v, std::span<const ObjectId> visible) {
   glNamedBufferSubData(buffer, 0, GLsizeiptr(bits.size() * sizeof(GLuint)), bits.data());
 }
 
+void Renderer::read_visible(Visibility v, std::vector<ObjectId>& out) {
+  Impl& g = *impl_;
+  const BackendTimer timer{stats_.backend_ms};
+  const GLuint buffer = g.visibility_buffer(v, "read_visible");
+  const std::size_t n = g.scene.objects().size();
+  std::vector<GLuint> bits(n);
+  glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);  // phase 2 wrote them from a shader
+  if (n > 0) glGetNamedBufferSubData(buffer, 0, GLsizeiptr(n * sizeof(GLuint)), bits.data());
+  for (ObjectId id = 0; id < n; ++id)
+    if (bits[id]) out.push_back(id);
+  check_error("reading back a visibility");
+}
+
 void Renderer::draw_previously_visible(Visibility v) {
   Impl& g = *impl_;
   const BackendTimer timer{stats_.backend_ms};

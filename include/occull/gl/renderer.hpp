@@ -171,6 +171,7 @@ class Renderer final : public Backend, public DeviceCulling {
   void draw_newly_visible(Visibility v, int texels) override;
   DeviceCullingTimes read_drawn(std::vector<ObjectId>& out) override;
   void set_visible(Visibility v, std::span<const ObjectId> visible) override;
+  void read_visible(Visibility v, std::vector<ObjectId>& out) override;
   /// Whether device draws are compacted (drawn with a count the device
   /// wrote) rather than one command per object. Precondition: a
   /// DeviceCulling call was made.
