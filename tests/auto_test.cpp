@@ -64,6 +64,18 @@ TEST(AutoSchedule, ATryAboveCutTimesTheBestIsLostByFar) {
   EXPECT_EQ(std::count(ran.begin() + 7, ran.end(), 1u), 0) << "its next try waits 4 x period frames at least";
 }
 
+TEST(AutoSchedule, AFrameFarBeyondAnySpikeEndsATryAtOnce) {
+  detail::AutoSchedule s(config(), 3);
+  s.no_cold_frame();
+  const auto ran = run(s, {1.0, 10.0, 1.1}, 6);
+  EXPECT_EQ(ran, (std::vector<std::size_t>{0, 0, 1, 2, 2, 0})) << "candidate 1's one frame at 10x the best ends its try";
+  EXPECT_EQ(s.current(), 0u);
+  detail::AutoSchedule near(config(), 3);
+  near.no_cold_frame();
+  EXPECT_EQ(run(near, {1.0, 7.0, 1.1}, 6), (std::vector<std::size_t>{0, 0, 1, 1, 2, 2}))
+      << "7x may be a spike: two frames decide";
+}
+
 TEST(AutoSchedule, OneFrameSpikeDoesNotDecideATry) {
   detail::AutoSchedule s(config(), 2);
   for (const double cost : {2.0, 2.0, 2.0})  // the uncounted first frame, candidate 0's try at 2

@@ -84,6 +84,13 @@ namespace {
 // (auto.hpp).
 constexpr double kSpike = 2.0;
 
+// A try's frame above this times the reference (the current's cost, in the
+// start's round the cheapest measured) ends the try at once: far beyond any
+// spike of the machine seen (4-5x: llvmpipe's page-fault storms), and where
+// one more such frame is what auto loses most (CHC's try on an H200's open
+// field: 76 and 70 ms against 1.5).
+constexpr double kFar = 8.0;
+
 }  // namespace
 
 AutoSchedule::AutoSchedule(AutoConfig config, std::size_t candidates)
@@ -264,9 +271,11 @@ void AutoSchedule::finished(double cost) {
     ++trial_frame_;
     // Lost by far: every frame of the try above cut x the reference; one
     // frame decides only when it is no spike against the candidate's last
-    // measure (a loser tried again), else two do (the start's round).
+    // measure (a loser tried again) or above kFar x the reference, else two
+    // do (the start's round).
     const double against = reference(running_), lowest = *std::min_element(samples_.begin(), samples_.end());
-    const bool confirmed = trial_frame_ >= 2 || (cost_[running_] > 0.0 && cost <= kSpike * cost_[running_]);
+    const bool confirmed = trial_frame_ >= 2 || (cost_[running_] > 0.0 && cost <= kSpike * cost_[running_]) ||
+                           (against > 0.0 && cost > kFar * against);
     const bool cut = confirmed && against > 0.0 && lowest > config_.cut * against;
     if (trial_frame_ >= config_.trial || cut) end_trial();
     return;

@@ -44,7 +44,8 @@ struct AutoConfig {
 ///
 /// A try of a challenger runs `trial` frames, or fewer when every one
 /// costs more than `cut` x the current's: one, when that frame is within
-/// twice the candidate's last measured cost (a loser tried again), else
+/// twice the candidate's last measured cost (a loser tried again) or above
+/// 8 x the current's (in the start's round: the cheapest measured), else
 /// two. No try costs more than `trial` frames of a loser. Its cost is the
 /// mean of its frames but spikes: a frame above twice the try's lowest is
 /// the machine's (a page fault storm, a descheduled driver thread: measured
