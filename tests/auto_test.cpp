@@ -74,6 +74,11 @@ TEST(AutoSchedule, AFrameFarBeyondAnySpikeEndsATryAtOnce) {
   near.no_cold_frame();
   EXPECT_EQ(run(near, {1.0, 7.0, 1.1}, 6), (std::vector<std::size_t>{0, 0, 1, 1, 2, 2}))
       << "7x may be a spike: two frames decide";
+  detail::AutoSchedule device(config(), 3);
+  device.no_cold_frame();
+  device.starts_up(1);
+  EXPECT_EQ(run(device, {1.0, 10.0, 1.1}, 6), (std::vector<std::size_t>{0, 0, 1, 1, 2, 2}))
+      << "a first try of a candidate that starts up (hiz) is not ended by its first frame";
 }
 
 TEST(AutoSchedule, OneFrameSpikeDoesNotDecideATry) {

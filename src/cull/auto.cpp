@@ -96,7 +96,9 @@ constexpr double kFar = 8.0;
 AutoSchedule::AutoSchedule(AutoConfig config, std::size_t candidates)
     : config_(std::move(config)), count_(candidates), cost_(candidates, 0.0), estimate_(candidates, 0.0),
       estimated_in_(candidates, 0),
-      losses_(candidates, 0), next_try_(candidates, 0), disabled_(candidates, false) {}
+      losses_(candidates, 0), next_try_(candidates, 0), disabled_(candidates, false), starts_up_(candidates, false) {}
+
+void AutoSchedule::starts_up(std::size_t c) { starts_up_[c] = true; }
 
 void AutoSchedule::start_trial(std::size_t c) {
   running_ = c;
@@ -271,11 +273,12 @@ void AutoSchedule::finished(double cost) {
     ++trial_frame_;
     // Lost by far: every frame of the try above cut x the reference; one
     // frame decides only when it is no spike against the candidate's last
-    // measure (a loser tried again) or above kFar x the reference, else two
-    // do (the start's round).
+    // measure (a loser tried again) or above kFar x the reference (but in
+    // the first try of a candidate that starts up), else two do (the
+    // start's round).
     const double against = reference(running_), lowest = *std::min_element(samples_.begin(), samples_.end());
-    const bool confirmed = trial_frame_ >= 2 || (cost_[running_] > 0.0 && cost <= kSpike * cost_[running_]) ||
-                           (against > 0.0 && cost > kFar * against);
+    const bool far = against > 0.0 && cost > kFar * against && !(starts_up_[running_] && cost_[running_] == 0.0);
+    const bool confirmed = trial_frame_ >= 2 || (cost_[running_] > 0.0 && cost <= kSpike * cost_[running_]) || far;
     const bool cut = confirmed && against > 0.0 && lowest > config_.cut * against;
     if (trial_frame_ >= config_.trial || cut) end_trial();
     return;
@@ -488,6 +491,8 @@ class AutoCuller final : public Culler {
           left > 1) {
         schedule_.disable(c);
         --left;
+      } else if (candidates_[c].device) {
+        schedule_.starts_up(c);
       }
     // A candidate that cannot be resumed keeps no visibility across frames
     // (soc, vfc): its first frame is no cold one.

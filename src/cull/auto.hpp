@@ -92,6 +92,11 @@ class AutoSchedule {
   /// Never runs candidate `c` again (it cannot run here: hiz on a backend
   /// without device culling). Precondition: some other candidate remains.
   void disable(std::size_t c);
+  /// Candidate `c`'s first frame may hold one-off costs (hiz: the device's
+  /// buffers made, its programs compiled by the driver: 122 ms against 2 on
+  /// an H200, 315 ms with a cold shader cache on llvmpipe): until it was
+  /// measured once, one frame above 8 x the reference does not end its try.
+  void starts_up(std::size_t c);
   /// An estimate of candidate `c`'s cost of the frame finished() counts
   /// next, in finished()'s unit (0: none). `of_this_view`: made from this
   /// frame's view (it may then switch to `c` when below (1 - margin) x both
@@ -126,6 +131,7 @@ class AutoSchedule {
   std::vector<std::uint32_t> losses_;
   std::vector<std::uint64_t> next_try_;
   std::vector<bool> disabled_;
+  std::vector<bool> starts_up_;    // see starts_up()
   std::vector<double> samples_;    // the try's frames
   std::size_t current_ = 0;
   std::size_t running_ = 0;

@@ -496,7 +496,7 @@ void Renderer::read_visible(Visibility v, std::vector<ObjectId>& out) {
   Impl& g = *impl_;
   const BackendTimer timer{stats_.backend_ms};
   const GLuint buffer = g.visibility_buffer(v, "read_visible");
-  const std::size_t n = g.scene.objects().size();
+  const std::size_t n = std::min(g.scene.objects().size(), g.object_capacity);  // the buffer's size
   std::vector<GLuint> bits(n);
   glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);  // phase 2 wrote them from a shader
   if (n > 0) glGetNamedBufferSubData(buffer, 0, GLsizeiptr(n * sizeof(GLuint)), bits.data());
