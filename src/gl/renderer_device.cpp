@@ -496,13 +496,16 @@ void Renderer::read_visible(Visibility v, std::vector<ObjectId>& out) {
   Impl& g = *impl_;
   const BackendTimer timer{stats_.backend_ms};
   const GLuint buffer = g.visibility_buffer(v, "read_visible");
-  const std::size_t n = std::min(g.scene.objects().size(), g.object_capacity);  // the buffer's size
-  std::vector<GLuint> bits(n);
-  glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);  // phase 2 wrote them from a shader
-  if (n > 0) glGetNamedBufferSubData(buffer, 0, GLsizeiptr(n * sizeof(GLuint)), bits.data());
-  for (ObjectId id = 0; id < n; ++id)
-    if (bits[id]) out.push_back(id);
+  g.read_flags(buffer, std::min(g.scene.objects().size(), g.object_capacity), out);  // no further than it holds
   check_error("reading back a visibility");
+}
+
+void Renderer::Impl::read_flags(GLuint buffer, std::size_t n, std::vector<ObjectId>& out) const {
+  std::vector<GLuint> flags(n);
+  glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);  // the cull shader wrote them
+  if (n > 0) glGetNamedBufferSubData(buffer, 0, GLsizeiptr(n * sizeof(GLuint)), flags.data());
+  for (ObjectId id = 0; id < n; ++id)
+    if (flags[id]) out.push_back(id);
 }
 
 void Renderer::draw_previously_visible(Visibility v) {
@@ -565,12 +568,7 @@ DeviceCullingTimes Renderer::read_drawn(std::vector<ObjectId>& out) {
   DeviceCullingTimes times;
   if (!g.device || !g.device->in_frame) return times;
   DeviceState& d = *g.device;
-  const std::size_t n = g.scene.objects().size();
-  std::vector<GLuint> drawn(n);
-  glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
-  if (n > 0) glGetNamedBufferSubData(d.drawn, 0, GLsizeiptr(n * 4), drawn.data());
-  for (ObjectId id = 0; id < n; ++id)
-    if (drawn[id]) out.push_back(id);
+  g.read_flags(d.drawn, g.scene.objects().size(), out);
   const auto span_ms = [&](int a, int b) {
     const std::uint32_t both = (1u << a) | (1u << b);
     if ((d.stamps_written & both) != both) return 0.0;

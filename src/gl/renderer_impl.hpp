@@ -213,6 +213,9 @@ struct Renderer::Impl {
   void dispatch_cull(int phase, GLuint visibility);
   // The buffer of visibility `v`; std::logic_error naming `call` when there is none.
   GLuint visibility_buffer(DeviceCulling::Visibility v, const char* call) const;
+  // Appends, ascending, the ids whose flag (one GLuint per object, written by
+  // the cull shader) is set in `buffer`'s first `n`; waits for the device.
+  void read_flags(GLuint buffer, std::size_t n, std::vector<ObjectId>& out) const;
   void draw_device_translucent();
   void stamp(int k);
   // `opaque` by material, stably (a front-to-back order within a material survives).
