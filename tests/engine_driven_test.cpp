@@ -41,7 +41,7 @@ TEST(EngineDrivenScene, EveryAlgorithmFollowsMovesAdditionsAndRemovals) {
     Bvh bvh = Bvh::build(scene);
     Options options;
     if (info.name == "nohc" || info.name == "auto") options.set("nohc.profile", profile.path());
-    auto culler = make_culler(info.name, {scene, bvh}, options);
+    auto culler = make_culler(info.name, {scene, bvh}, options, test::reading_profiles());
     test::ScriptedBackend backend;
     std::vector<Aabb> visible;
     backend.visible_samples = [&visible](std::span<const Aabb> boxes) {

@@ -3,7 +3,7 @@
 #include "gl_test_util.hpp"
 #include "occull/error.hpp"
 #include "occull/report.hpp"
-#include "eval/watchdog.hpp"
+#include "lab/watchdog.hpp"
 #include "test_util.hpp"
 
 #include <gtest/gtest.h>

@@ -1,6 +1,6 @@
 // The run-time invariants of the instrument, each broken on purpose through
 // a fault hook: a check that has never been seen failing is not trusted.
-#include "eval/invariants.hpp"
+#include "lab/invariants.hpp"
 #include "gl_test_util.hpp"
 #include "occull/error.hpp"
 #include "occull/harness.hpp"

@@ -52,7 +52,7 @@ std::map<std::string, std::vector<ObjectId>> render_with_every_culler(const Scen
   const Bvh bvh = Bvh::build(scene);
   std::map<std::string, std::vector<ObjectId>> out;
   for (const auto& [name, options] : every_culler()) {
-    auto culler = make_culler(name, {scene, bvh}, options);
+    auto culler = make_culler(name, {scene, bvh}, options, test::reading_profiles());
     test::ScriptedBackend backend;
     for (int f = 0; f < frames; ++f) {
       backend.rendered.clear();

@@ -92,7 +92,7 @@ TEST(QueryOwnership, EveryBvhAlgorithmHandsBackEveryQuery) {
     Options options;
     for (const auto& [k, v] : base.values())
       if (k.rfind(info.name + ".", 0) == 0 || info.name == "auto") options.set(k, v);
-    auto culler = make_culler(info.name, {scene, bvh}, options);
+    auto culler = make_culler(info.name, {scene, bvh}, options, test::reading_profiles());
     test::ScriptedBackend backend;
     int frame = 0;
     make_slow_and_changing(backend, frame);

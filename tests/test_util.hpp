@@ -4,6 +4,7 @@
 
 #include "occull/backend.hpp"
 #include "occull/cost_model.hpp"
+#include "occull/culler.hpp"
 #include "occull/profile_io.hpp"
 #include "occull/scene.hpp"
 
@@ -49,6 +50,14 @@ class ProfileFile {
  private:
   std::string path_;
 };
+
+/// A culler context that reads the profile files options name
+/// (nohc.profile=FILE), as Session's does.
+inline CullerContext reading_profiles() {
+  CullerContext context;
+  context.read_profile = load_profile;
+  return context;
+}
 
 /// A closed box mesh (12 triangles) spanning b, outward CCW faces.
 /// A view whose "truth" is a test double's geometry rather than an image

@@ -3,6 +3,7 @@
 
 #include "occull/backend.hpp"
 #include "occull/bvh.hpp"
+#include "occull/cost_model.hpp"
 #include "occull/scene.hpp"
 #include "occull/stats.hpp"
 #include "occull/tiles.hpp"
@@ -11,6 +12,7 @@
 #include <functional>
 #include <map>
 #include <memory>
+#include <optional>
 #include <span>
 #include <string>
 #include <string_view>
@@ -20,7 +22,6 @@ namespace occull {
 
 class OcclusionBuffer;
 
-struct HardwareProfile;
 
 /// What a culler reads: the scene and its hierarchy, shared read-only by
 /// every culler instance. Both must outlive the cullers made from them; the
@@ -255,10 +256,17 @@ void check_options(const Options& options);
 /// makes it. Pointers are borrowed: they must outlive make_culler() only.
 ///
 /// nohc's calibrated hardware cost model (occull/cost_model.hpp) comes from,
-/// in this order: the file its option nohc.profile names; `nohc_profile`;
-/// `nohc_profile_source()`. Without any, making nohc throws InputError, and
-/// auto's default candidates leave nohc out.
+/// in this order: the file its option nohc.profile names, read by
+/// `read_profile`; `nohc_profile`; `nohc_profile_source()`. Without any,
+/// making nohc throws InputError, and auto's default candidates leave nohc
+/// out.
 struct CullerContext {
+  /// Reads the profile file an option names (nohc.profile=FILE): nullopt
+  /// when the file does not exist; throws InputError when it is corrupt.
+  /// The culling core reads no files: occull::lab's load_profile
+  /// (occull/profile_io.hpp) is one, and Session sets it. Unset, an option
+  /// that names a file makes make_culler() throw InputError.
+  std::function<std::optional<HardwareProfile>(const std::string& file)> read_profile;
   /// A profile in memory (e.g. one from gl::calibrate).
   const HardwareProfile* nohc_profile = nullptr;
   /// Called only when a culler needs a profile and none of the above gives

@@ -39,8 +39,8 @@
 namespace occull {
 
 namespace detail {
-class Watchdog;    // src/eval/watchdog.hpp
-struct FrameLabel;  // src/eval/invariants.hpp
+class Watchdog;    // src/lab/watchdog.hpp
+struct FrameLabel;  // src/lab/invariants.hpp
 }  // namespace detail
 
 /// Where opaque geometry covers an image: one bit per pixel (row-major,
@@ -166,7 +166,7 @@ struct FaultHooks {
 /// A scene set up on the GL device: the context, the generated scene with
 /// its paths, its BVH and the renderer. Everything a run of frames needs.
 ///
-/// Verified runs check the run-time invariants of src/eval/invariants.hpp
+/// Verified runs check the run-time invariants of src/lab/invariants.hpp
 /// on every frame (the truth pass covers what the full scene shows, the
 /// truth is non-empty where anything is drawn, an independent CPU probe of
 /// sampled triangles, every algorithm frame within the truth, the oracle

@@ -5,7 +5,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <fmt/format.h>
+#include "core/format.hpp"
 
 namespace occull {
 
@@ -47,7 +47,7 @@ float UniformGrid::default_cell_size(const Scene& scene) {
 
 UniformGrid UniformGrid::of_scene(const Scene& scene, float cell_size) {
   if (!(cell_size >= 0.0f) || !std::isfinite(cell_size))
-    throw InputError(fmt::format("grid cell size {}: must be a positive number of scene units (0: default)", cell_size));
+    throw InputError(detail::format("grid cell size {}: must be a positive number of scene units (0: default)", cell_size));
   if (cell_size == 0.0f) cell_size = default_cell_size(scene);
   Aabb bounds = scene.bounds();
   // Where dynamic objects go: their loops, grown by their size.
@@ -64,7 +64,7 @@ UniformGrid UniformGrid::of_scene(const Scene& scene, float cell_size) {
   for (int a = 0; a < 3; ++a) {
     const double n = std::ceil(double(bounds.max[a] - bounds.min[a]) / double(cell_size));
     if (n > double(kMaxCellsPerAxis))
-      throw InputError(fmt::format("grid cell size {}: the scene's {:.0f} units along {} would need {:.0f} cells "
+      throw InputError(detail::format("grid cell size {}: the scene's {:.0f} units along {} would need {:.0f} cells "
                                    "(at most 2^20); choose larger cells",
                                    cell_size, bounds.max[a] - bounds.min[a], "xyz"[a], n));
     g.dims[a] = std::max(1, int(n));
@@ -78,7 +78,7 @@ UniformGrid UniformGrid::of_scene(const Scene& scene, float cell_size) {
     listings += double(r.hi.x - r.lo.x + 1) * double(r.hi.y - r.lo.y + 1) * double(r.hi.z - r.lo.z + 1);
   }
   if (listings > double(kMaxListings))
-    throw InputError(fmt::format("grid cell size {}: the objects would be listed in {:.0f} cells (at most 2^26); "
+    throw InputError(detail::format("grid cell size {}: the objects would be listed in {:.0f} cells (at most 2^26); "
                                  "choose larger cells",
                                  cell_size, listings));
   for (ObjectId id = 0; id < objects.size(); ++id)

@@ -3,7 +3,7 @@
 #include "occull/error.hpp"
 #include "occull/input_limits.hpp"
 
-#include <fmt/format.h>
+#include "core/format.hpp"
 
 #include <glm/gtc/matrix_transform.hpp>
 
@@ -57,7 +57,7 @@ glm::mat4 Motion::transform_at(double time_s) const {
 MeshId Scene::add_mesh(Mesh mesh) {
   assert(mesh.normals.size() == mesh.positions.size());
   if (mesh_triangles_ + mesh.triangle_count() > caps_.mesh_triangles)
-    throw InputError(fmt::format("scene {}: {} triangles in its meshes is past the limit of {} "
+    throw InputError(detail::format("scene {}: {} triangles in its meshes is past the limit of {} "
                                  "(occull::limits::mesh_triangles)",
                                  name_, mesh_triangles_ + mesh.triangle_count(), caps_.mesh_triangles));
   mesh_triangles_ += mesh.triangle_count();
@@ -71,11 +71,11 @@ MeshId Scene::add_mesh(Mesh mesh) {
 MeshId Scene::add_mesh(const MeshInfo& info) {
   const auto finite = [](const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); };
   if (!info.bounds.empty() && !(finite(info.bounds.min) && finite(info.bounds.max)))
-    throw InputError(fmt::format("scene {}: a mesh's bounds ({}, {}, {}) - ({}, {}, {}) must be finite", name_,
+    throw InputError(detail::format("scene {}: a mesh's bounds ({}, {}, {}) - ({}, {}, {}) must be finite", name_,
                                  info.bounds.min.x, info.bounds.min.y, info.bounds.min.z, info.bounds.max.x,
                                  info.bounds.max.y, info.bounds.max.z));
   if (!(info.surface_area >= 0.0) || !std::isfinite(info.surface_area))
-    throw InputError(fmt::format("scene {}: a mesh's surface area {} must be a finite number >= 0", name_,
+    throw InputError(detail::format("scene {}: a mesh's surface area {} must be a finite number >= 0", name_,
                                  info.surface_area));
   mesh_bounds_.push_back(info.bounds);
   mesh_area_.push_back(info.surface_area);
@@ -102,10 +102,10 @@ bool finite(const glm::mat4& m) {
 
 void Scene::check_object(ObjectId id, const char* what) const {
   if (id >= objects_.size())
-    throw InputError(fmt::format("scene {}: {} object {}: no such object (ids 0 to {})", name_, what, id,
+    throw InputError(detail::format("scene {}: {} object {}: no such object (ids 0 to {})", name_, what, id,
                                  objects_.size() == 0 ? 0 : objects_.size() - 1));
   if (objects_[id].removed)
-    throw InputError(fmt::format("scene {}: {} object {}: it was removed", name_, what, id));
+    throw InputError(detail::format("scene {}: {} object {}: it was removed", name_, what, id));
 }
 
 void Scene::note_moved(ObjectId id) {
@@ -117,12 +117,12 @@ void Scene::note_moved(ObjectId id) {
 ObjectId Scene::add_object(MeshId mesh, MaterialId material, const glm::mat4& transform,
                            OccluderClass occluder) {
   if (mesh >= meshes_.size())
-    throw InputError(fmt::format("scene {}: mesh {} does not exist ({} meshes)", name_, mesh, meshes_.size()));
+    throw InputError(detail::format("scene {}: mesh {} does not exist ({} meshes)", name_, mesh, meshes_.size()));
   if (material >= materials_.size())
-    throw InputError(fmt::format("scene {}: material {} does not exist ({} materials)", name_, material,
+    throw InputError(detail::format("scene {}: material {} does not exist ({} materials)", name_, material,
                                  materials_.size()));
   if (!finite(transform))
-    throw InputError(fmt::format("scene {}: a new object's transform has an entry that is not finite", name_));
+    throw InputError(detail::format("scene {}: a new object's transform has an entry that is not finite", name_));
   ObjectId id;
   if (!free_ids_.empty()) {
     id = free_ids_.back();
@@ -130,7 +130,7 @@ ObjectId Scene::add_object(MeshId mesh, MaterialId material, const glm::mat4& tr
     objects_[id] = make_object(mesh, material, transform, occluder);
   } else {
     if (objects_.size() >= caps_.objects)
-      throw InputError(fmt::format("scene {}: more than {} objects, the limit (occull::limits::objects)", name_,
+      throw InputError(detail::format("scene {}: more than {} objects, the limit (occull::limits::objects)", name_,
                                    caps_.objects));
     objects_.push_back(make_object(mesh, material, transform, occluder));
     id = ObjectId(objects_.size() - 1);
@@ -143,7 +143,7 @@ ObjectId Scene::add_object(MeshId mesh, MaterialId material, const glm::mat4& tr
 void Scene::set_transform(ObjectId id, const glm::mat4& transform) {
   check_object(id, "set_transform of");
   if (!finite(transform))
-    throw InputError(fmt::format("scene {}: set_transform of object {}: the transform has an entry that is not finite",
+    throw InputError(detail::format("scene {}: set_transform of object {}: the transform has an entry that is not finite",
                                  name_, id));
   Object& o = objects_[id];
   o.transform = transform;
@@ -189,13 +189,13 @@ ObjectId Scene::add_dynamic_object(MeshId mesh, MaterialId material, Motion moti
 
 void Scene::set_motion(std::size_t index, Motion motion) {
   if (index >= motions_.size())
-    throw InputError(fmt::format("scene {}: set_motion of motion {}: the scene has {}", name_, index, motions_.size()));
+    throw InputError(detail::format("scene {}: set_motion of motion {}: the scene has {}", name_, index, motions_.size()));
   const bool finite_points = std::all_of(motion.waypoints.begin(), motion.waypoints.end(), [](const glm::vec3& p) {
     return std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z);
   });
   if (motion.waypoints.size() < 2 || !finite_points || !std::isfinite(motion.speed) || motion.speed <= 0.0f ||
       !std::isfinite(motion.start_offset))
-    throw InputError(fmt::format("scene {}: set_motion of motion {}: needs 2 or more finite waypoints and a finite "
+    throw InputError(detail::format("scene {}: set_motion of motion {}: needs 2 or more finite waypoints and a finite "
                                  "speed > 0",
                                  name_, index));
   motions_[index] = std::move(motion);

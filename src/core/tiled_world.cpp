@@ -4,7 +4,7 @@
 #include "occull/error.hpp"
 #include "occull/input_limits.hpp"
 
-#include <fmt/format.h>
+#include "core/format.hpp"
 #include <glm/gtc/matrix_transform.hpp>
 
 #include <algorithm>
@@ -29,11 +29,11 @@ TiledWorld::TiledWorld(const Scene& scene, float cell_size, std::vector<Tile> ti
                        float reach)
     : cell_size_(cell_size), tiles_(std::move(tiles)), seed_(seed) {
   if (!(cell_size_ > 0.0f) || !std::isfinite(cell_size_))
-    throw InputError(fmt::format("tiled world: cell size {} must be a positive number", cell_size_));
+    throw InputError(detail::format("tiled world: cell size {} must be a positive number", cell_size_));
   if (tiles_.empty()) throw InputError("tiled world: the tiling set has no tiles");
   for (Tile& t : tiles_) {
-    if (t.objects.empty()) throw InputError(fmt::format("tiled world: tile {} has no objects", t.name));
-    if (!(t.weight > 0.0f)) throw InputError(fmt::format("tiled world: tile {} has weight {}", t.name, t.weight));
+    if (t.objects.empty()) throw InputError(detail::format("tiled world: tile {} has no objects", t.name));
+    if (!(t.weight > 0.0f)) throw InputError(detail::format("tiled world: tile {} has weight {}", t.name, t.weight));
     total_weight_ += t.weight;
     std::vector<std::uint32_t> triangles;
     t.object_bounds.clear();
@@ -60,7 +60,7 @@ TiledWorld::TiledWorld(const Scene& scene, float cell_size, std::vector<Tile> ti
   const std::size_t side = std::size_t(2 * radius_ + 1);
   const std::size_t objects = side * side * per_cell_;
   if (objects > limits::objects)
-    throw InputError(fmt::format("tiled world: a window of {}x{} cells of {} objects is {} objects, past the "
+    throw InputError(detail::format("tiled world: a window of {}x{} cells of {} objects is {} objects, past the "
                                  "limit of {} (occull::limits::objects); lower the far plane or the tile sizes",
                                  side, side, per_cell_, objects, limits::objects));
 }
@@ -173,13 +173,13 @@ bool TiledWorld::covers(const View& view) const {
 }
 
 std::string TiledWorld::describe(ObjectId id) const {
-  if (per_cell_ == 0 || id / per_cell_ >= slot_cell_.size()) return fmt::format("object {}", id);
+  if (per_cell_ == 0 || id / per_cell_ >= slot_cell_.size()) return detail::format("object {}", id);
   const std::size_t s = id / per_cell_;
   const std::uint32_t i = id % per_cell_;
   const TileCoord c = slot_cell_[s];
   const Tile& tile = tiles_[tile_at(c)];
-  if (i >= tile.objects.size()) return fmt::format("object {} (unused id of cell ({}, {}))", id, c.x, c.z);
-  return fmt::format("tile {} at ({}, {}), object {}", tile.name, c.x, c.z, i);
+  if (i >= tile.objects.size()) return detail::format("object {} (unused id of cell ({}, {}))", id, c.x, c.z);
+  return detail::format("tile {} at ({}, {}), object {}", tile.name, c.x, c.z, i);
 }
 
 }  // namespace occull

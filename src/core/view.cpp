@@ -3,7 +3,7 @@
 #include "occull/error.hpp"
 #include "occull/input_limits.hpp"
 
-#include <fmt/format.h>
+#include "core/format.hpp"
 #include <glm/gtc/constants.hpp>
 #include <glm/gtc/matrix_transform.hpp>
 
@@ -20,12 +20,12 @@ void check_finite(const glm::mat4& m, const char* what) {
   for (int c = 0; c < 4; ++c)
     for (int r = 0; r < 4; ++r)
       if (!std::isfinite(m[c][r]))
-        throw InputError(fmt::format("{} matrix: entry [column {}][row {}] is {}; every entry must be finite", what,
+        throw InputError(detail::format("{} matrix: entry [column {}][row {}] is {}; every entry must be finite", what,
                                      c, r, m[c][r]));
 }
 
 std::string depth_name(const ClipSpace& clip) {
-  return fmt::format("{} depth{}", clip.depth == DepthRange::zero_to_one ? "[0, 1]" : "[-1, 1]",
+  return detail::format("{} depth{}", clip.depth == DepthRange::zero_to_one ? "[0, 1]" : "[-1, 1]",
                      clip.reversed_z ? ", reversed" : "");
 }
 
@@ -79,19 +79,19 @@ View make_view(const glm::mat4& view, const glm::mat4& proj, int width, int heig
   check_finite(proj, "projection");
   const double view_det = double(glm::determinant(view));
   if (!(std::abs(view_det) > 1e-12) || !std::isfinite(view_det))
-    throw InputError(fmt::format("view matrix: determinant {} — it cannot be inverted (a camera needs a position and "
+    throw InputError(detail::format("view matrix: determinant {} — it cannot be inverted (a camera needs a position and "
                                  "three independent axes)",
                                  view_det));
   const double proj_det = double(glm::determinant(proj));
   if (!(std::abs(proj_det) > 0.0) || !std::isfinite(proj_det))
-    throw InputError(fmt::format("projection matrix: determinant {} — a singular projection maps space onto a plane",
+    throw InputError(detail::format("projection matrix: determinant {} — a singular projection maps space onto a plane",
                                  proj_det));
   // glm is column-major: proj[column][row]. The row that makes w.
   const double w_x = proj[0][3], w_y = proj[1][3], w_z = proj[2][3], w_1 = proj[3][3];
   const bool perspective = w_x == 0.0 && w_y == 0.0 && w_z != 0.0 && w_1 == 0.0;
   const bool orthographic = w_x == 0.0 && w_y == 0.0 && w_z == 0.0 && w_1 != 0.0;
   if (!perspective && !orthographic)
-    throw InputError(fmt::format("projection matrix: its w row ({}, {}, {}, {}) is neither perspective (w from "
+    throw InputError(detail::format("projection matrix: its w row ({}, {}, {}, {}) is neither perspective (w from "
                                  "eye-space z alone, (0, 0, -1, 0)) nor orthographic ((0, 0, 0, 1))",
                                  w_x, w_y, w_z, w_1));
   const double z_z = proj[2][2], z_1 = proj[3][2];
@@ -108,7 +108,7 @@ View make_view(const glm::mat4& view, const glm::mat4& proj, int width, int heig
     near = distance_at(zn);
     far = distance_at(zf);
     if (!(near > 0.0) || !std::isfinite(near))
-      throw InputError(fmt::format("projection matrix: its near plane (normalised depth {} with {}) lies {} scene "
+      throw InputError(detail::format("projection matrix: its near plane (normalised depth {} with {}) lies {} scene "
                                    "units in front of the eye; a perspective view needs it in front (> 0). Are the "
                                    "clip conventions right (--depth, ClipSpace)?",
                                    zn, depth_name(clip), near));
@@ -124,7 +124,7 @@ View make_view(const glm::mat4& view, const glm::mat4& proj, int width, int heig
     far = forward * z_far;
   }
   if (!(far > near))
-    throw InputError(fmt::format("projection matrix: near {} and far {} scene units with {}: depth must grow from the "
+    throw InputError(detail::format("projection matrix: near {} and far {} scene units with {}: depth must grow from the "
                                  "near plane to the far plane",
                                  near, far, depth_name(clip)));
   View v;
@@ -164,7 +164,7 @@ glm::mat4 perspective_reversed_infinite(float fov_y, float aspect, float near) n
 DepthMode parse_depth_mode(std::string_view name) {
   if (name == "standard") return DepthMode::standard;
   if (name == "reversed") return DepthMode::reversed;
-  throw InputError(fmt::format("depth mode '{}': must be standard (OpenGL's [-1, 1]) or reversed (reversed-Z in "
+  throw InputError(detail::format("depth mode '{}': must be standard (OpenGL's [-1, 1]) or reversed (reversed-Z in "
                                "[0, 1], infinite far plane)",
                                name));
 }
@@ -174,14 +174,14 @@ View make_view(const CameraPose& pose, const Lens& lens, int width, int height) 
   const glm::vec3& p = pose.position;
   if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z) || !std::isfinite(pose.yaw) ||
       !std::isfinite(pose.pitch))
-    throw InputError(fmt::format("camera at ({}, {}, {}) with yaw {} and pitch {} rad: every number must be finite",
+    throw InputError(detail::format("camera at ({}, {}, {}) with yaw {} and pitch {} rad: every number must be finite",
                                  p.x, p.y, p.z, pose.yaw, pose.pitch));
   if (!(std::abs(pose.pitch) < glm::half_pi<float>()))
-    throw InputError(fmt::format("camera pitch {} rad: must be within (-pi/2, pi/2)", pose.pitch));
+    throw InputError(detail::format("camera pitch {} rad: must be within (-pi/2, pi/2)", pose.pitch));
   if (!(lens.fov_y_degrees > 0.0f && lens.fov_y_degrees < 180.0f))
-    throw InputError(fmt::format("lens field of view {} degrees: must be within (0, 180)", lens.fov_y_degrees));
+    throw InputError(detail::format("lens field of view {} degrees: must be within (0, 180)", lens.fov_y_degrees));
   if (!(lens.near > 0.0f && lens.far > lens.near && std::isfinite(lens.far)))
-    throw InputError(fmt::format("lens near {} far {}: needs 0 < near < far < infinity (a near plane of 0 leaves "
+    throw InputError(detail::format("lens near {} far {}: needs 0 < near < far < infinity (a near plane of 0 leaves "
                                  "the depth buffer no precision)",
                                  lens.near, lens.far));
   const float cp = std::cos(pose.pitch);

@@ -70,7 +70,7 @@
 #include "occull/error.hpp"
 #include "traversal.hpp"
 
-#include <fmt/format.h>
+#include "core/format.hpp"
 
 #include <algorithm>
 #include <array>
@@ -616,7 +616,7 @@ Registration auto_registration() {
         for (const std::string& name : names) {
           const AlgorithmInfo& info = find_algorithm(parse_algorithm_spec(name, o).name);
           if (info.name == "auto" || info.harness_only || !info.conservative)
-            throw InputError(fmt::format("option auto.candidates: '{}' cannot be a candidate (auto runs conservative "
+            throw InputError(detail::format("option auto.candidates: '{}' cannot be a candidate (auto runs conservative "
                                          "cullers other than itself)",
                                          name));
           candidates.push_back(

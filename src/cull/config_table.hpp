@@ -10,7 +10,7 @@
 #include "occull/culler.hpp"
 #include "occull/error.hpp"
 
-#include <fmt/format.h>
+#include "core/format.hpp"
 
 #include <functional>
 #include <type_traits>
@@ -69,7 +69,7 @@ class ConfigTable {
             }
             valid += (valid.empty() ? "" : ", ") + name;
           }
-          throw InputError(fmt::format("option {}: '{}' is not one of {}", k, it->second, valid));
+          throw InputError(detail::format("option {}: '{}' is not one of {}", k, it->second, valid));
         },
         [at, names](const Config& c) -> std::string {
           for (const auto& [name, value] : names)
@@ -104,7 +104,7 @@ class ConfigTable {
   /// or lies outside its range. Keys of other algorithms are ignored.
   [[nodiscard]] Config parse(const Options& options, std::string_view algo) const {
     Config c;
-    for (const Field& f : fields_) f.read(c, options, fmt::format("{}.{}", algo, f.info.key));
+    for (const Field& f : fields_) f.read(c, options, detail::format("{}.{}", algo, f.info.key));
     return c;
   }
   /// The registry's description of every field, defaults from Config{}.
@@ -132,7 +132,7 @@ class ConfigTable {
   // A number field read by Options::get_int (Bound int) or get_double.
   template <class At, class Bound>
   void number(std::string key, At at, Bound lo, Bound hi, std::string help) {
-    add(std::move(key), std::move(help), fmt::format("[{}, {}]", lo, hi),
+    add(std::move(key), std::move(help), detail::format("[{}, {}]", lo, hi),
         [at, lo, hi](Config& c, const Options& o, const std::string& k) {
           auto& m = std::invoke(at, c);
           using T = std::remove_reference_t<decltype(m)>;
@@ -141,7 +141,7 @@ class ConfigTable {
           else
             m = static_cast<T>(o.get_double(k, double(m), lo, hi));
         },
-        [at](const Config& c) { return fmt::format("{}", std::invoke(at, c)); });
+        [at](const Config& c) { return detail::format("{}", std::invoke(at, c)); });
   }
   struct Field {
     OptionInfo info;

@@ -9,7 +9,7 @@
 #include <cctype>
 #include <charconv>
 #include <cmath>
-#include <fmt/format.h>
+#include "core/format.hpp"
 
 namespace occull {
 namespace {
@@ -55,7 +55,7 @@ void Options::set(std::string_view assignment) {
   const auto dot = assignment.find('.');
   if (eq == std::string_view::npos || dot == std::string_view::npos || dot > eq || dot == 0 ||
       dot + 1 == eq)
-    throw InputError(fmt::format("option '{}' is not of the form algorithm.key=value "
+    throw InputError(detail::format("option '{}' is not of the form algorithm.key=value "
                                  "(e.g. chcpp.batch=50)",
                                  assignment));
   set(std::string(assignment.substr(0, eq)), std::string(assignment.substr(eq + 1)));
@@ -68,9 +68,9 @@ int Options::get_int(const std::string& key, int fallback, int lo, int hi) const
   const std::string& s = it->second;
   const auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
   if (ec != std::errc() || end != s.data() + s.size())
-    throw InputError(fmt::format("option {}: '{}' is not a whole number", key, s));
+    throw InputError(detail::format("option {}: '{}' is not a whole number", key, s));
   if (v < lo || v > hi)
-    throw InputError(fmt::format("option {}: {} is outside [{}, {}]", key, v, lo, hi));
+    throw InputError(detail::format("option {}: {} is outside [{}, {}]", key, v, lo, hi));
   return v;
 }
 
@@ -81,9 +81,9 @@ double Options::get_double(const std::string& key, double fallback, double lo, d
   double v = 0.0;
   const auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
   if (ec != std::errc() || end != s.data() + s.size() || !std::isfinite(v))
-    throw InputError(fmt::format("option {}: '{}' is not a number", key, s));
+    throw InputError(detail::format("option {}: '{}' is not a number", key, s));
   if (v < lo || v > hi)
-    throw InputError(fmt::format("option {}: {} is outside [{}, {}]", key, v, lo, hi));
+    throw InputError(detail::format("option {}: {} is outside [{}, {}]", key, v, lo, hi));
   return v;
 }
 
@@ -93,7 +93,7 @@ bool Options::get_bool(const std::string& key, bool fallback) const {
   const std::string v = lower(it->second);
   if (v == "on" || v == "true" || v == "yes" || v == "1") return true;
   if (v == "off" || v == "false" || v == "no" || v == "0") return false;
-  throw InputError(fmt::format("option {}: '{}' is not on/off", key, it->second));
+  throw InputError(detail::format("option {}: '{}' is not on/off", key, it->second));
 }
 
 std::span<const AlgorithmInfo> algorithms() {
@@ -120,7 +120,7 @@ void check_option(const Registration& entry, const std::string& key, const std::
     if (o.key == sub) return;
     valid += (valid.empty() ? "" : ", ") + o.key;
   }
-  throw InputError(fmt::format("unknown option '{}' of {}; valid options: {}", key, entry.info.name,
+  throw InputError(detail::format("unknown option '{}' of {}; valid options: {}", key, entry.info.name,
                                valid.empty() ? "(none)" : valid));
 }
 
@@ -132,7 +132,7 @@ void check_options(const Options& options) {
     const std::string algo = key.substr(0, dot);
     const Registration* entry = find(algo);
     if (!entry)
-      throw InputError(fmt::format("option '{}' names unknown algorithm '{}'; valid algorithms: {}",
+      throw InputError(detail::format("option '{}' names unknown algorithm '{}'; valid algorithms: {}",
                                    key, algo, algorithm_names()));
     check_option(*entry, key, key.substr(dot + 1));
   }
@@ -158,12 +158,12 @@ const AlgorithmInfo& find_algorithm(std::string_view name) {
   for (const AlgorithmInfo& a : algorithms())
     if (a.name == name) return a;
   throw InputError(
-      fmt::format("unknown algorithm '{}'; valid algorithms: {}", name, algorithm_names()));
+      detail::format("unknown algorithm '{}'; valid algorithms: {}", name, algorithm_names()));
 }
 
 AlgorithmSpec parse_algorithm_spec(std::string_view spec, const Options& base) {
   if (spec.size() > limits::spec_chars)
-    throw InputError(fmt::format("algorithm spec '{}...': {} characters is past the limit of {} "
+    throw InputError(detail::format("algorithm spec '{}...': {} characters is past the limit of {} "
                                  "(occull::limits::spec_chars)",
                                  spec.substr(0, 32), spec.size(), limits::spec_chars));
   const auto colon = spec.find(':');
@@ -175,7 +175,7 @@ AlgorithmSpec parse_algorithm_spec(std::string_view spec, const Options& base) {
     const std::string_view item = rest.substr(0, next);
     rest = next == std::string_view::npos ? std::string_view{} : rest.substr(next + 1);
     if (item.find('=') == std::string_view::npos)
-      throw InputError(fmt::format("algorithm '{}': '{}' is not key=value", spec, item));
+      throw InputError(detail::format("algorithm '{}': '{}' is not key=value", spec, item));
     out.options.set(info.name + "." + std::string(item));
   }
   check_options(out.options);
@@ -225,7 +225,7 @@ namespace {
 const Registration& makeable(const AlgorithmSpec& spec, const SceneIndex& index) {
   const Registration* entry = find(spec.name);
   if (!entry->make)
-    throw InputError(fmt::format("{} needs each frame's ground truth: it runs only in the harness "
+    throw InputError(detail::format("{} needs each frame's ground truth: it runs only in the harness "
                                  "(occull bench)",
                                  entry->info.name));
   const bool tiled = index.world != nullptr;
@@ -233,7 +233,7 @@ const Registration& makeable(const AlgorithmSpec& spec, const SceneIndex& index)
     std::string fits;
     for (const Registration& e : registry())
       if (runs_on(e.info, tiled)) fits += (fits.empty() ? "" : ", ") + e.info.name;
-    throw InputError(fmt::format("{} does not run on {}; algorithms that do: {}", entry->info.name,
+    throw InputError(detail::format("{} does not run on {}; algorithms that do: {}", entry->info.name,
                                  tiled ? "a tiled world (it has no global BVH)" : "a scene that is not a tiled world",
                                  fits));
   }
@@ -261,7 +261,7 @@ std::unique_ptr<Culler> make_culler(std::string_view spec_text, const SceneIndex
 
 std::unique_ptr<SplitScreen> make_split_screen(std::string_view spec_text, const SceneIndex& index, int views,
                                                const Options& base, const CullerContext& context) {
-  if (views < 1 || views > 16) throw InputError(fmt::format("{} views: must be in [1, 16]", views));
+  if (views < 1 || views > 16) throw InputError(detail::format("{} views: must be in [1, 16]", views));
   const AlgorithmSpec spec = parse_algorithm_spec(spec_text, base);
   const Registration& entry = makeable(spec, index);
   if (entry.make_views) return entry.make_views(index, views, spec.options, context);

@@ -43,9 +43,10 @@ class Resumable {
 };
 
 /// nohc's hardware profile for a culler: the file `file` names (the option
-/// nohc.profile), else `context.nohc_profile`, else
+/// nohc.profile, read by `context.read_profile`), else `context.nohc_profile`, else
 /// `context.nohc_profile_source()`. Throws
-/// InputError when there is none, or the file does not exist.
+/// InputError when there is none, the file does not exist, or nothing
+/// reads files.
 HardwareProfile nohc_profile(const CullerContext& context, const std::string& file);
 
 }  // namespace occull::detail

@@ -52,7 +52,7 @@
 #include "occull/grid.hpp"
 #include "occull/grid_views.hpp"
 
-#include <fmt/format.h>
+#include "core/format.hpp"
 
 #include <algorithm>
 #include <memory>
@@ -375,7 +375,7 @@ QueryBudget::QueryBudget(int total, int views, double floor, Policy policy)
       reports_(std::size_t(views), 0), forced_(std::size_t(views), 0),
       optional_(std::size_t(views) * kDemandWindow, 0) {
   if (views < 1 || total < views || !(floor >= 0.0 && floor <= 1.0))
-    throw InputError(fmt::format("query budget: {} queries for {} views (floor {}) cannot be split", total, views,
+    throw InputError(detail::format("query budget: {} queries for {} views (floor {}) cannot be split", total, views,
                                  floor));
   for (int& a : allowance_) a = total / views;
 }
@@ -447,7 +447,7 @@ void QueryBudget::split() {
 }
 
 GridViews::GridViews(const SceneIndex& index, int views, const Options& options) {
-  if (views < 1 || views > 16) throw InputError(fmt::format("{} views: must be in [1, 16]", views));
+  if (views < 1 || views > 16) throw InputError(detail::format("{} views: must be in [1, 16]", views));
   check_options(options);
   const detail::GridConfig c = detail::grid_table().parse(options, "grid");
   grid_ = std::make_shared<UniformGrid>(UniformGrid::of_scene(index.scene, c.cell));

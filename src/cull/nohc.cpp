@@ -18,10 +18,9 @@
 
 #include "cullers.hpp"
 #include "occull/error.hpp"
-#include "occull/profile_io.hpp"
 #include "traversal.hpp"
 
-#include <fmt/format.h>
+#include "core/format.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -376,8 +375,12 @@ class NohcCuller final : public CpuTestedCuller {
 
 HardwareProfile nohc_profile(const CullerContext& context, const std::string& file) {
   if (!file.empty()) {
-    std::optional<HardwareProfile> profile = load_profile(file);
-    if (!profile) throw InputError(fmt::format("nohc.profile: '{}' does not exist", file));
+    if (!context.read_profile)
+      throw InputError(detail::format("nohc.profile={}: this program reads no profile files (CullerContext::read_profile "
+                                      "is unset; occull::lab's load_profile reads them)",
+                                      file));
+    std::optional<HardwareProfile> profile = context.read_profile(file);
+    if (!profile) throw InputError(detail::format("nohc.profile: '{}' does not exist", file));
     return std::move(*profile);
   }
   if (context.nohc_profile) return *context.nohc_profile;

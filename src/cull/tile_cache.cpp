@@ -3,7 +3,7 @@
 
 #include "occull/error.hpp"
 
-#include <fmt/format.h>
+#include "core/format.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -78,7 +78,7 @@ void TileCache::end_frame() {
 
 const TiledWorld& tiled_world(const SceneIndex& index, std::string_view algorithm) {
   if (!index.world)
-    throw InputError(fmt::format("{} runs on tiled worlds only (tiles_city, tiles_forest, tiles_hybrid)", algorithm));
+    throw InputError(detail::format("{} runs on tiled worlds only (tiles_city, tiles_forest, tiles_hybrid)", algorithm));
   return *index.world;
 }
 

@@ -272,6 +272,7 @@ std::unique_ptr<Culler> Session::make(std::string_view spec, const Options& opti
 
 CullerContext Session::culler_context(const std::function<void(const std::string&)>& progress) {
   CullerContext context;  // nohc: the calibrated profile, unless an option names a file
+  context.read_profile = load_profile;
   context.nohc_profile_source = [this, progress]() -> const HardwareProfile& { return hardware_profile(progress); };
   return context;
 }
