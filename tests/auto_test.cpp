@@ -16,8 +16,8 @@ using namespace occull;
 
 namespace {
 
-detail::AutoConfig config() {
-  detail::AutoConfig c;
+AutoConfig config() {
+  AutoConfig c;
   c.trial = 2;
   c.period = 10;
   c.margin = 0.05;
@@ -56,7 +56,7 @@ TEST(AutoSchedule, AFirstCandidateWithoutStateIsMeasuredFromItsFirstFrame) {
 }
 
 TEST(AutoSchedule, ATryAboveCutTimesTheBestIsLostByFar) {
-  const detail::AutoConfig c = config();
+  const AutoConfig c = config();
   detail::AutoSchedule s(c, 3);
   const auto ran = run(s, {2.0, 9.0, 2.2}, 7 + 4 * c.period);
   EXPECT_EQ(std::vector<std::size_t>(ran.begin(), ran.begin() + 7), (std::vector<std::size_t>{0, 0, 0, 1, 1, 2, 2}));
@@ -107,7 +107,7 @@ TEST(AutoSchedule, KeepsTheCheapestFromFrameOnePlusTrialTimesCandidatesOn) {
   // The documented convergence: with fixed costs, the cheapest runs from
   // frame 1 + trial x candidates on, until the first retry of a loser:
   // period frames after the start's round, which takes 1 + candidates frames at least.
-  const detail::AutoConfig c = config();
+  const AutoConfig c = config();
   std::uint64_t seed = 12345;
   for (int round = 0; round < 50; ++round) {
     const std::size_t n = 2 + std::size_t(round % 5);
@@ -125,7 +125,7 @@ TEST(AutoSchedule, KeepsTheCheapestFromFrameOnePlusTrialTimesCandidatesOn) {
 }
 
 TEST(AutoSchedule, TakesACheaperChallengerWithinTrialPlusSixteenPeriods) {
-  const detail::AutoConfig c = config();
+  const AutoConfig c = config();
   detail::AutoSchedule s(c, 2);
   run(s, {1.0, 9.0}, 3000);  // candidate 1 loses by far, again and again: the longest wait
   ASSERT_EQ(s.current(), 0u);
@@ -136,7 +136,7 @@ TEST(AutoSchedule, TakesACheaperChallengerWithinTrialPlusSixteenPeriods) {
 
 TEST(AutoSchedule, DoesNotAlternateBetweenTwoEqualCandidates) {
   // Equal costs that vary by up to 3 % from frame to frame (less than the default margin).
-  detail::AutoSchedule s(detail::AutoConfig{}, 2);
+  detail::AutoSchedule s(AutoConfig{}, 2);
   std::uint64_t seed = 99;
   for (int k = 0; k < 5000; ++k) {
     seed = seed * 6364136223846793005ull + 1442695040888963407ull;
@@ -146,7 +146,7 @@ TEST(AutoSchedule, DoesNotAlternateBetweenTwoEqualCandidates) {
 }
 
 TEST(AutoSchedule, ATryRunsAtMostTrialFramesOfALoserAndOneOfAKnownLoserAboveCut) {
-  const detail::AutoConfig c = config();
+  const AutoConfig c = config();
   detail::AutoSchedule s(c, 3);
   const auto ran = run(s, {1.0, 1.2, 5.0}, 3000);
   ASSERT_EQ(s.current(), 0u);

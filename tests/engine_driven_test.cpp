@@ -16,19 +16,6 @@
 
 using namespace occull;
 
-namespace {
-
-std::vector<Aabb> scattered_boxes(int n) {
-  std::vector<Aabb> boxes;
-  for (int i = 0; i < n; ++i) {
-    const float x = float((i * 37) % 23) - 11.0f, y = float((i * 11) % 13) - 6.0f;
-    const float z = -6.0f - float((i * 7) % 45);
-    boxes.push_back({{x, y, z}, {x + 0.7f + float(i % 3), y + 0.8f, z + 0.9f}});
-  }
-  return boxes;
-}
-
-}  // namespace
 
 TEST(EngineDrivenScene, EveryAlgorithmFollowsMovesAdditionsAndRemovals) {
   const test::ProfileFile profile("occull-engine-" + std::to_string(::getpid()) + ".json");
@@ -37,7 +24,7 @@ TEST(EngineDrivenScene, EveryAlgorithmFollowsMovesAdditionsAndRemovals) {
   for (const AlgorithmInfo& info : algorithms()) {
     if (info.harness_only || !runs_on(info, false)) continue;
     if (info.device) continue;  // culls on the device: hiz_gl_test.cpp
-    Scene scene = test::box_scene(scattered_boxes(120));
+    Scene scene = test::box_scene(test::scattered_boxes(120));
     Bvh bvh = Bvh::build(scene);
     Options options;
     if (info.name == "nohc" || info.name == "auto") options.set("nohc.profile", profile.path());

@@ -186,6 +186,21 @@ TEST(OsgCullingGroup, NestedTransformsComposeAsOsgDoesAndSharedGeometryIsOneMesh
   }
 }
 
+TEST(OsgCullingGroup, ATypedConfigMakesTheCullersAndIsCheckedAtOnce) {
+  osg::ref_ptr<OcclusionCullingGroup> made = new OcclusionCullingGroup(occull::ChcppConfig{.batch = 20});
+  EXPECT_EQ(made->algorithm(), "chcpp");
+  HeadlessViewer v(64, 64);
+  Walled s;
+  s.group->set_config(occull::StopWaitConfig{.common = {.virtual_leaf_triangles = 0}});
+  v.set_scene(s.group.get());
+  v.frame(camera_view(), 0.0);
+  EXPECT_FALSE(drew(*s.group, v.camera(), object_of(*s.group, s.hidden->getDrawable(0))));
+  EXPECT_TRUE(drew(*s.group, v.camera(), object_of(*s.group, s.shown->getDrawable(0))));
+  EXPECT_THROW(s.group->set_config(occull::ChcppConfig{.batch = 0}), occull::InputError);  // outside [1, 100000]
+  EXPECT_THROW(s.group->set_config(occull::HizConfig{}), occull::InputError);  // needs device culling
+  EXPECT_EQ(s.group->algorithm(), "stopwait");  // neither was taken
+}
+
 TEST(OsgCullingGroup, ACameraOrProjectionBelowTheGroupIsRefused) {
   HeadlessViewer v(64, 64);
   osg::ref_ptr<OcclusionCullingGroup> group = new OcclusionCullingGroup("vfc");

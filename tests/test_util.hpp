@@ -59,6 +59,19 @@ inline CullerContext reading_profiles() {
   return context;
 }
 
+/// `n` boxes of 1-3 x 0.8 x 0.9 units scattered over x in [-11, 14],
+/// y in [-6, 7], z in [-50, -5]: in front of a camera at the origin looking
+/// down -Z, some overlapping.
+inline std::vector<Aabb> scattered_boxes(int n) {
+  std::vector<Aabb> boxes;
+  for (int i = 0; i < n; ++i) {
+    const float x = float((i * 37) % 23) - 11.0f, y = float((i * 11) % 13) - 6.0f;
+    const float z = -6.0f - float((i * 7) % 45);
+    boxes.push_back({{x, y, z}, {x + 0.7f + float(i % 3), y + 0.8f, z + 0.9f}});
+  }
+  return boxes;
+}
+
 /// A closed box mesh (12 triangles) spanning b, outward CCW faces.
 /// A view whose "truth" is a test double's geometry rather than an image
 /// sampled at pixel centres: no exact sub-pixel culling (View::samples = 0),

@@ -12,7 +12,8 @@
 // drew. Exit 0: no object missed; 1: a miss or a query left in flight;
 // 2: bad arguments; 3: no OpenGL 4.5.
 //
-//   occull_example_engine [--algo chcpp] [--frames N] [--size WxH]
+//   occull_example_engine [--algo SPEC] [--frames N] [--size WxH]
+#include <occull/configs.hpp>
 #include <occull/culler.hpp>
 #include <occull/error.hpp>
 #include <occull/gl/context.hpp>
@@ -298,7 +299,7 @@ glm::mat4 reversed_infinite(float fov_y, float aspect, float near) {
 }
 
 struct Args {
-  std::string algo = "chcpp";
+  std::string algo;  // a spec; empty: the engine's own typed config (chcpp, batch 20)
   int frames = 120;
   int width = 320, height = 180;
 };
@@ -314,8 +315,8 @@ Args parse(int argc, char** argv) {
     } else if (arg == "--size" && i + 1 < argc) {
       if (std::sscanf(argv[++i], "%dx%d", &a.width, &a.height) != 2) throw occull::InputError("--size WIDTHxHEIGHT");
     } else if (arg == "--help" || arg == "-h") {
-      std::printf("occull_example_engine [--algo NAME] [--frames N] [--size WxH]: a small engine culling with "
-                  "occull (chcpp by default), checked against occull's ground truth (exit 0: nothing missed)\n");
+      std::printf("occull_example_engine [--algo SPEC] [--frames N] [--size WxH]: a small engine culling with "
+                  "occull (chcpp with batches of 20 by default), checked against occull's ground truth (exit 0: nothing missed)\n");
       std::exit(0);
     } else {
       throw occull::InputError("unknown argument " + arg + " (--algo NAME, --frames N, --size WxH, --help)");
@@ -389,7 +390,10 @@ int run(const Args& args) {
 
   // [readme: frame]
   occull::Bvh bvh = occull::Bvh::build(scene);
-  auto culler = occull::make_culler(args.algo, {scene, bvh});  // "chcpp" (or "chcpp:batch=20", ...)
+  // The engine's choice in a typed config (a misspelt field does not compile); --algo picks another
+  // by its spec at run time ("nohc", "chcpp:batch=20", ...).
+  auto culler = args.algo.empty() ? occull::make_culler(occull::ChcppConfig{.batch = 20}, {scene, bvh})
+                                  : occull::make_culler(args.algo, {scene, bvh});
   EngineBackend backend(objects, meshes);
   // [readme end]
 

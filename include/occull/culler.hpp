@@ -3,6 +3,7 @@
 
 #include "occull/backend.hpp"
 #include "occull/bvh.hpp"
+#include "occull/configs.hpp"
 #include "occull/cost_model.hpp"
 #include "occull/scene.hpp"
 #include "occull/stats.hpp"
@@ -284,6 +285,45 @@ struct CullerContext {
 /// the message lists those that do), or nohc without a profile.
 [[nodiscard]] std::unique_ptr<Culler> make_culler(std::string_view spec, const SceneIndex& index,
                                                   const Options& options = {}, const CullerContext& context = {});
+
+/// Makes a culler from its typed config (occull/configs.hpp), as
+/// make_culler(spec) makes one from the options of a spec:
+///
+///   auto culler = make_culler(ChcppConfig{.batch = 20}, {scene, bvh});
+///
+/// Throws InputError for a value outside its option's range (named as the
+/// option: "option chcpp.batch: 0 is outside [1, 100000]"), a scene of a
+/// kind the algorithm does not run on, or nohc without a profile. An
+/// algorithm that makes others (auto's candidates, tiles' local culler)
+/// makes them with their defaults.
+[[nodiscard]] std::unique_ptr<Culler> make_culler(const NoneConfig& config, const SceneIndex& index,
+                                                  const CullerContext& context = {});
+[[nodiscard]] std::unique_ptr<Culler> make_culler(const VfcConfig& config, const SceneIndex& index,
+                                                  const CullerContext& context = {});
+[[nodiscard]] std::unique_ptr<Culler> make_culler(const StopWaitConfig& config, const SceneIndex& index,
+                                                  const CullerContext& context = {});
+[[nodiscard]] std::unique_ptr<Culler> make_culler(const ChcConfig& config, const SceneIndex& index,
+                                                  const CullerContext& context = {});
+[[nodiscard]] std::unique_ptr<Culler> make_culler(const ChcppConfig& config, const SceneIndex& index,
+                                                  const CullerContext& context = {});
+[[nodiscard]] std::unique_ptr<Culler> make_culler(const NohcConfig& config, const SceneIndex& index,
+                                                  const CullerContext& context = {});
+[[nodiscard]] std::unique_ptr<Culler> make_culler(const SocConfig& config, const SceneIndex& index,
+                                                  const CullerContext& context = {});
+[[nodiscard]] std::unique_ptr<Culler> make_culler(const HizConfig& config, const SceneIndex& index,
+                                                  const CullerContext& context = {});
+[[nodiscard]] std::unique_ptr<Culler> make_culler(const PerObjectConfig& config, const SceneIndex& index,
+                                                  const CullerContext& context = {});
+[[nodiscard]] std::unique_ptr<Culler> make_culler(const GridConfig& config, const SceneIndex& index,
+                                                  const CullerContext& context = {});
+[[nodiscard]] std::unique_ptr<Culler> make_culler(const AutoConfig& config, const SceneIndex& index,
+                                                  const CullerContext& context = {});
+[[nodiscard]] std::unique_ptr<Culler> make_culler(const TileVfcConfig& config, const SceneIndex& index,
+                                                  const CullerContext& context = {});
+[[nodiscard]] std::unique_ptr<Culler> make_culler(const PerTileConfig& config, const SceneIndex& index,
+                                                  const CullerContext& context = {});
+[[nodiscard]] std::unique_ptr<Culler> make_culler(const TilesConfig& config, const SceneIndex& index,
+                                                  const CullerContext& context = {});
 
 /// The cullers of the views of one frame (split screen), one per view.
 class SplitScreen {

@@ -5,6 +5,7 @@
 // view keeps its own cell answers and durations.
 #pragma once
 
+#include "occull/configs.hpp"
 #include "occull/culler.hpp"
 #include "occull/grid.hpp"
 
@@ -70,7 +71,7 @@ namespace occull {
 /// with floor 1 is therefore GridViews' default.
 class QueryBudget {
  public:
-  enum class Policy { reveal, even };
+  using Policy = SplitPolicy;
 
   /// Preconditions: views >= 1, total >= views, 0 <= floor <= 1.
   QueryBudget(int total, int views, double floor = 1.0, Policy policy = Policy::reveal);

@@ -1,11 +1,11 @@
 #include "occull/grid.hpp"
 
 #include "occull/error.hpp"
+#include "core/format.hpp"
 
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include "core/format.hpp"
 
 namespace occull {
 

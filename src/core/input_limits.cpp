@@ -2,7 +2,6 @@
 #include "occull/input_limits.hpp"
 
 #include "occull/error.hpp"
-
 #include "core/format.hpp"
 
 #include <filesystem>

@@ -2,7 +2,6 @@
 
 #include "occull/error.hpp"
 #include "occull/input_limits.hpp"
-
 #include "core/format.hpp"
 
 #include <glm/gtc/matrix_transform.hpp>

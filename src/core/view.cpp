@@ -2,8 +2,8 @@
 
 #include "occull/error.hpp"
 #include "occull/input_limits.hpp"
-
 #include "core/format.hpp"
+
 #include <glm/gtc/constants.hpp>
 #include <glm/gtc/matrix_transform.hpp>
 

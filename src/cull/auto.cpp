@@ -69,7 +69,6 @@
 #include "cullers.hpp"
 #include "occull/error.hpp"
 #include "traversal.hpp"
-
 #include "core/format.hpp"
 
 #include <algorithm>

@@ -2,34 +2,13 @@
 // frame by frame (the culler is in auto.cpp).
 #pragma once
 
+#include "occull/configs.hpp"
+
 #include <cstdint>
 #include <string>
 #include <vector>
 
 namespace occull::detail {
-
-struct AutoConfig {
-  /// Candidates, joined by +, tried in this order at the start. soc first:
-  /// it keeps no state across frames, so its first frame is already a
-  /// settled one and costs about vfc's where it occludes little, and the
-  /// query cullers after it start from its visible set (hand-over) instead
-  /// of from nothing (CHC's cold first frame queries every node: 343 ms
-  /// against vfc's 70 on field at 1280x720); where soc cannot run (no CPU
-  /// vertices, OpenSceneGraph's group) chc opens, which settles in one
-  /// frame where CHC++ takes several (CHC++ first left a large city's round
-  /// measuring everything against its unsettled frames, 2.2x the best at
-  /// 320x180). By default every conservative culler that was the cheapest
-  /// on some entry of `occull bench --suite default`; hiz only on a backend
-  /// with device culling (auto.cpp). Not nohc: never the cheapest there,
-  /// and its first frame costs 2-3x its later ones.
-  std::string candidates = "soc+chc+chcpp+hiz+vfc";
-  int trial = 2;           ///< frames a try runs (its cost: their mean, spikes left out)
-  int period = 40;         ///< frames before a loser's next try; doubled after each further loss, up to 16x
-  double margin = 0.08;    ///< a challenger must be this much cheaper than the current to take over (hysteresis)
-  double cut = 1.3;        ///< a try costing above this times the current's lost by far
-  double skip = 1.5;       ///< a challenger estimated above this times the current's cost is not tried (a lost try)
-  double smoothing = 0.15; ///< weight of the newest frame in the running cost of the current culler
-};
 
 /// Which candidate runs each frame, from the measured cost of the frames
 /// run so far (any unit, the same for every frame; auto passes

@@ -24,12 +24,6 @@
 namespace occull::detail {
 namespace {
 
-struct ChcConfig {
-  CommonOptions common;
-  std::uint32_t skip = 0;         ///< n_av
-  std::uint32_t flush_every = 8;  ///< queries handed to the device together
-};
-
 class ChcCuller final : public CpuTestedCuller {
  public:
   ChcCuller(const SceneIndex& index, const ChcConfig& c)
@@ -122,7 +116,7 @@ class ChcCuller final : public CpuTestedCuller {
   }
 
   SceneIndex index_;
-  CommonOptions common_;
+  QueryOptions common_;
   std::uint32_t skip_;
   std::vector<NodeState> state_;
   ObjectVisibility seen_;  // what was drawn, for state_ after a rebuild of the hierarchy

@@ -12,24 +12,6 @@
 
 namespace occull::detail {
 
-struct ChcppConfig {
-  std::uint32_t batch = 50;       ///< b: i-queue nodes per query batch
-  bool v_queue = true;            ///< defer visible-leaf queries to fill idle time
-  bool multiquery = true;         ///< group i-queue nodes into multiqueries
-  bool jitter = true;             ///< randomise the first re-query of a newly visible leaf
-  std::uint32_t n_av = 6;         ///< frames between queries of a visible leaf
-  QueryShape shape{true, 3, 1.4f};
-  CommonOptions common{0, 1500};  ///< threshold 0; virtual leaves up to 1500 triangles
-  std::uint32_t leaf_objects = 0; ///< ... and at most this many objects (0: any number)
-  std::uint32_t pkeep_min_samples = 20;  ///< tests at one i before the measured p_keep(i) is used
-  std::uint64_t seed = 1;                ///< of the jitter
-  bool flush_batches = true;             ///< Backend::flush() after each query batch
-  std::uint64_t render_batch_triangles = 20000;  ///< hand the render queue over at this size (0: only before queries)
-  double enter_p_min = 0.1;   ///< query entering nodes where at least this share of them is found occluded (0: always)
-  std::uint32_t backoff = 2;  ///< a leaf found visible k times in a row waits n_av * 2^min(k-1, backoff) frames
-  int gate_depth = 5;         ///< the entering statistics are kept per subtree rooted at this BVH depth
-};
-
 /// Whether queries of *entering* nodes pay: nodes that were not found
 /// occluded in the previous frame and were not visible either (outside the
 /// frustum, or not reached). CHC queries every one; where few of them turn

@@ -9,11 +9,11 @@
 
 #include "occull/culler.hpp"
 #include "occull/error.hpp"
-
 #include "core/format.hpp"
 
 #include <functional>
 #include <type_traits>
+#include <typeinfo>
 #include <string>
 #include <utility>
 #include <vector>
@@ -75,6 +75,14 @@ class ConfigTable {
           for (const auto& [name, value] : names)
             if (value == std::invoke(at, c)) return name;
           return "?";
+        },
+        [at, names](const Config& c, const std::string& k) {
+          std::string valid;
+          for (const auto& [name, value] : names) {
+            if (value == std::invoke(at, c)) return;
+            valid += (valid.empty() ? "" : ", ") + name;
+          }
+          throw InputError(detail::format("option {}: the config's value is not one of {}", k, valid));
         });
     return std::move(*this);
   }
@@ -106,6 +114,13 @@ class ConfigTable {
     Config c;
     for (const Field& f : fields_) f.read(c, options, detail::format("{}.{}", algo, f.info.key));
     return c;
+  }
+  /// Checks a config made in code (make_culler(ChcppConfig{...})) as
+  /// parse() checks options: throws InputError naming the first field
+  /// outside its range, as its option ("option chcpp.batch: ...").
+  void check(const Config& c, std::string_view algo) const {
+    for (const Field& f : fields_)
+      if (f.check) f.check(c, detail::format("{}.{}", algo, f.info.key));
   }
   /// The registry's description of every field, defaults from Config{}.
   [[nodiscard]] std::vector<OptionInfo> describe() const {
@@ -141,26 +156,32 @@ class ConfigTable {
           else
             m = static_cast<T>(o.get_double(k, double(m), lo, hi));
         },
-        [at](const Config& c) { return detail::format("{}", std::invoke(at, c)); });
+        [at](const Config& c) { return detail::format("{}", std::invoke(at, c)); },
+        [at, lo, hi](const Config& c, const std::string& k) {
+          const double v = double(std::invoke(at, c));
+          if (!(v >= double(lo) && v <= double(hi)))  // NaN too
+            throw InputError(detail::format("option {}: {} is outside [{}, {}]", k, std::invoke(at, c), lo, hi));
+        });
   }
   struct Field {
     OptionInfo info;
     std::function<void(Config&, const Options&, const std::string&)> read;
     std::function<std::string(const Config&)> show;
+    /// Throws InputError when a config's value is outside the field's range
+    /// (null: every value is valid, as for a flag or text).
+    std::function<void(const Config&, const std::string&)> check;
   };
   template <class Read, class Show>
-  void add(std::string key, std::string help, std::string values, Read read, Show show) {
+  void add(std::string key, std::string help, std::string values, Read read, Show show,
+           std::function<void(const Config&, const std::string&)> check = nullptr) {
     OptionInfo info;
     info.key = std::move(key);
     info.values = std::move(values);
     info.help = std::move(help);
-    fields_.push_back(Field{std::move(info), std::move(read), std::move(show)});
+    fields_.push_back(Field{std::move(info), std::move(read), std::move(show), std::move(check)});
   }
   std::vector<Field> fields_;
 };
-
-/// The config of an algorithm without options.
-struct NoOptions {};
 
 /// How the registry makes an algorithm from options (null: harness only).
 using Factory = std::function<std::unique_ptr<Culler>(const SceneIndex&, const Options&, const CullerContext&)>;
@@ -170,10 +191,16 @@ using Factory = std::function<std::unique_ptr<Culler>(const SceneIndex&, const O
 using SplitFactory =
     std::function<std::unique_ptr<SplitScreen>(const SceneIndex&, int views, const Options&, const CullerContext&)>;
 
+/// How the registry makes an algorithm from its typed config (a `const
+/// Config*` of the registration's config_type), checked by its table.
+using ConfigFactory = std::function<std::unique_ptr<Culler>(const SceneIndex&, const void*, const CullerContext&)>;
+
 /// An algorithm as the registry holds it.
 struct Registration {
   AlgorithmInfo info;
   Factory make;
+  ConfigFactory make_config;
+  const std::type_info* config_type = nullptr;  ///< what make_config takes
   SplitFactory make_views;  ///< set with info.shares_views
   /// Variants `occull bench` runs by default besides the plain name.
   std::vector<std::string> bench_variants;
@@ -189,10 +216,16 @@ template <class Config, class Make>
 Registration registered(AlgorithmInfo info, const ConfigTable<Config>& table, Make make) {
   info.options = table.describe();
   const std::string name = info.name;
-  Registration r{std::move(info), {}, {}, {}, {}};
+  Registration r{std::move(info), {}, {}, {}, {}, {}, {}};
   r.make = [&table, name, make](const SceneIndex& index, const Options& o, const CullerContext& context) {
     return make(index, table.parse(o, name), o, context);
   };
+  r.make_config = [&table, name, make](const SceneIndex& index, const void* config, const CullerContext& context) {
+    const Config& c = *static_cast<const Config*>(config);
+    table.check(c, name);
+    return make(index, c, Options{}, context);
+  };
+  r.config_type = &typeid(Config);
   r.approximate = [&table, name](const Options& o) { return table.approximate(o, name); };
   return r;
 }

@@ -4,12 +4,14 @@
 #include "cullers.hpp"
 #include "occull/error.hpp"
 #include "occull/input_limits.hpp"
+#include "core/format.hpp"
 
 #include <algorithm>
+#include <cassert>
 #include <cctype>
 #include <charconv>
 #include <cmath>
-#include "core/format.hpp"
+#include <typeinfo>
 
 namespace occull {
 namespace {
@@ -220,10 +222,11 @@ std::vector<ObjectId> objects_not_drawn(const Scene& scene, const View& view, st
 
 namespace {
 
-// The registration a spec names, checked to run on `index`'s kind of scene
-// and outside the harness. Throws InputError otherwise.
-const Registration& makeable(const AlgorithmSpec& spec, const SceneIndex& index) {
-  const Registration* entry = find(spec.name);
+// The registration of algorithm `name`, checked to run on `index`'s kind of
+// scene and outside the harness. Throws InputError otherwise.
+const Registration& makeable(std::string_view name, const SceneIndex& index) {
+  const Registration* entry = find(name);
+  if (!entry) (void)find_algorithm(name);  // throws, listing the valid names
   if (!entry->make)
     throw InputError(detail::format("{} needs each frame's ground truth: it runs only in the harness "
                                  "(occull bench)",
@@ -238,6 +241,14 @@ const Registration& makeable(const AlgorithmSpec& spec, const SceneIndex& index)
                                  fits));
   }
   return *entry;
+}
+
+// A culler from its typed config, through the registration of Config::algorithm.
+template <class Config>
+std::unique_ptr<Culler> make_configured(const Config& config, const SceneIndex& index, const CullerContext& context) {
+  const Registration& entry = makeable(Config::algorithm, index);
+  assert(entry.config_type != nullptr && *entry.config_type == typeid(Config));
+  return entry.make_config(index, &config, context);
 }
 
 // Independent cullers, one per view.
@@ -256,18 +267,61 @@ class IndependentViews final : public SplitScreen {
 std::unique_ptr<Culler> make_culler(std::string_view spec_text, const SceneIndex& index, const Options& base,
                                     const CullerContext& context) {
   const AlgorithmSpec spec = parse_algorithm_spec(spec_text, base);
-  return makeable(spec, index).make(index, spec.options, context);
+  return makeable(spec.name, index).make(index, spec.options, context);
 }
 
 std::unique_ptr<SplitScreen> make_split_screen(std::string_view spec_text, const SceneIndex& index, int views,
                                                const Options& base, const CullerContext& context) {
   if (views < 1 || views > 16) throw InputError(detail::format("{} views: must be in [1, 16]", views));
   const AlgorithmSpec spec = parse_algorithm_spec(spec_text, base);
-  const Registration& entry = makeable(spec, index);
+  const Registration& entry = makeable(spec.name, index);
   if (entry.make_views) return entry.make_views(index, views, spec.options, context);
   std::vector<std::unique_ptr<Culler>> cullers;
   for (int k = 0; k < views; ++k) cullers.push_back(entry.make(index, spec.options, context));
   return std::make_unique<IndependentViews>(std::move(cullers));
+}
+
+std::unique_ptr<Culler> make_culler(const NoneConfig& config, const SceneIndex& index, const CullerContext& context) {
+  return make_configured(config, index, context);
+}
+std::unique_ptr<Culler> make_culler(const VfcConfig& config, const SceneIndex& index, const CullerContext& context) {
+  return make_configured(config, index, context);
+}
+std::unique_ptr<Culler> make_culler(const StopWaitConfig& config, const SceneIndex& index, const CullerContext& context) {
+  return make_configured(config, index, context);
+}
+std::unique_ptr<Culler> make_culler(const ChcConfig& config, const SceneIndex& index, const CullerContext& context) {
+  return make_configured(config, index, context);
+}
+std::unique_ptr<Culler> make_culler(const ChcppConfig& config, const SceneIndex& index, const CullerContext& context) {
+  return make_configured(config, index, context);
+}
+std::unique_ptr<Culler> make_culler(const NohcConfig& config, const SceneIndex& index, const CullerContext& context) {
+  return make_configured(config, index, context);
+}
+std::unique_ptr<Culler> make_culler(const SocConfig& config, const SceneIndex& index, const CullerContext& context) {
+  return make_configured(config, index, context);
+}
+std::unique_ptr<Culler> make_culler(const HizConfig& config, const SceneIndex& index, const CullerContext& context) {
+  return make_configured(config, index, context);
+}
+std::unique_ptr<Culler> make_culler(const PerObjectConfig& config, const SceneIndex& index, const CullerContext& context) {
+  return make_configured(config, index, context);
+}
+std::unique_ptr<Culler> make_culler(const GridConfig& config, const SceneIndex& index, const CullerContext& context) {
+  return make_configured(config, index, context);
+}
+std::unique_ptr<Culler> make_culler(const AutoConfig& config, const SceneIndex& index, const CullerContext& context) {
+  return make_configured(config, index, context);
+}
+std::unique_ptr<Culler> make_culler(const TileVfcConfig& config, const SceneIndex& index, const CullerContext& context) {
+  return make_configured(config, index, context);
+}
+std::unique_ptr<Culler> make_culler(const PerTileConfig& config, const SceneIndex& index, const CullerContext& context) {
+  return make_configured(config, index, context);
+}
+std::unique_ptr<Culler> make_culler(const TilesConfig& config, const SceneIndex& index, const CullerContext& context) {
+  return make_configured(config, index, context);
 }
 
 }  // namespace occull

@@ -51,7 +51,6 @@
 #include "occull/error.hpp"
 #include "occull/grid.hpp"
 #include "occull/grid_views.hpp"
-
 #include "core/format.hpp"
 
 #include <algorithm>
@@ -61,24 +60,6 @@
 
 namespace occull::detail {
 namespace {
-
-struct GridConfig {
-  float cell = 0.0f;
-  GridTraversal::Mode traversal = GridTraversal::Mode::frustum;
-  int cap = 4000;
-  int vis_duration = 20, vis_growth = 4;
-  int invis_duration = 1, invis_growth = 1;
-  int prepass = 75;
-  bool unknown_visible = true;
-  bool tight = true;
-  int latency = 0;  // frames before a hidden cell's answer is used (0: waited for at the frame's end)
-  std::optional<ConditionalWait> conditional = ConditionalWait::wait;  // none: off
-  std::uint64_t threshold = 0;
-  std::uint32_t seed = 1;
-  // Split screen (GridViews) only.
-  QueryBudget::Policy split = QueryBudget::Policy::reveal;
-  double split_floor = 1.0;
-};
 
 class GridCuller final : public Culler {
  public:
@@ -336,7 +317,7 @@ const ConfigTable<GridConfig>& grid_table() {
           .integer("threshold", &C::threshold, 0, 1 << 24, "a cell is visible when more samples (pixels) pass")
           .approximate_unless_default()
           .integer("seed", &C::seed, 0, 1 << 30, "random seed of the answers' extra duration when capped")
-          .choice("split", &C::split, {{"reveal", QueryBudget::Policy::reveal}, {"even", QueryBudget::Policy::even}},
+          .choice("split", &C::split, {{"reveal", SplitPolicy::reveal}, {"even", SplitPolicy::even}},
                   "split screen (bench --views): how the views share the cap; reveal: an even split of what the "
                   "queries of drawn cells leave, capped at each view's recent peak demand, and what a view does not "
                   "need lent in proportion to demand x share of its re-queries of hidden cells that found them "
@@ -449,11 +430,11 @@ void QueryBudget::split() {
 GridViews::GridViews(const SceneIndex& index, int views, const Options& options) {
   if (views < 1 || views > 16) throw InputError(detail::format("{} views: must be in [1, 16]", views));
   check_options(options);
-  const detail::GridConfig c = detail::grid_table().parse(options, "grid");
+  const GridConfig c = detail::grid_table().parse(options, "grid");
   grid_ = std::make_shared<UniformGrid>(UniformGrid::of_scene(index.scene, c.cell));
   budget_ = std::make_shared<QueryBudget>(std::max(c.cap, views), views, c.split_floor, c.split);
   for (int k = 0; k < views; ++k) {
-    detail::GridConfig view_config = c;
+    GridConfig view_config = c;
     view_config.seed = c.seed + std::uint32_t(k);
     views_.push_back(std::make_unique<detail::GridCuller>(index, view_config, grid_, budget_, k));
   }

@@ -27,10 +27,6 @@
 namespace occull::detail {
 namespace {
 
-struct HizConfig {
-  int texels = 8;
-};
-
 class HizCuller final : public Culler, public Resumable {
  public:
   explicit HizCuller(const HizConfig& config) : config_(config) {}

@@ -19,7 +19,6 @@
 #include "cullers.hpp"
 #include "occull/error.hpp"
 #include "traversal.hpp"
-
 #include "core/format.hpp"
 
 #include <algorithm>
@@ -79,18 +78,6 @@ double OcclusionCalibration::scale(PreviousState previous, double p) const {
 }
 
 namespace {
-
-struct NohcConfig {
-  CommonOptions common;
-  std::string profile;           // hardware profile file (empty: the context's)
-  double fragments_per_pixel = 2.0;
-  double visible_factor = 0.5;   // p_occl = factor · p_cov^2 for previously visible nodes
-  double levels = 0.0;           // 0: log2(N_h + 1)
-  int max_parallel = 0;          // 0: N_q from the profile
-  bool exact_area = true;        // projected box area instead of the paper's approximation
-  std::uint32_t flush_every = 8;  // queries handed to the device together
-  bool learn = true;              // correct p_occl by the measured outcomes (OcclusionCalibration)
-};
 
 class NohcCuller final : public CpuTestedCuller {
  public:

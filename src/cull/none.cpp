@@ -30,9 +30,9 @@ class NoneCuller final : public Culler {
 }  // namespace
 
 Registration none_registration() {
-  static const ConfigTable<NoOptions> table;
+  static const ConfigTable<NoneConfig> table;
   return registered({"none", "render every object (reference cost of no culling)", true, {}, false, SceneKind::any},
-                    table, [](const SceneIndex& index, const NoOptions&, const Options&, const CullerContext&) {
+                    table, [](const SceneIndex& index, const NoneConfig&, const Options&, const CullerContext&) {
                       return std::make_unique<NoneCuller>(index);
                     });
 }

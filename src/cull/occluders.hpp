@@ -2,6 +2,7 @@
 // them — shared by `soc` and the CPU first test (CpuTestBackend).
 #pragma once
 
+#include "occull/configs.hpp"
 #include "occull/occlusion_buffer.hpp"
 #include "occull/scene.hpp"
 #include "occull/stats.hpp"
@@ -10,13 +11,6 @@
 #include <vector>
 
 namespace occull::detail {
-
-/// What makes an object worth rasterizing.
-struct OccluderChoice {
-  int budget = 20000;       ///< triangles of `sometimes` occluders per frame (`always` ones always)
-  double min_texels = 2.0;  ///< occluders whose bounding sphere spans fewer texels across are not rasterized
-  double detail = 8.0;      ///< polygons below 1/detail of their mesh's largest inscribed circle left out (0: none)
-};
 
 /// Occluders: opaque objects of class `always`, and of class `sometimes`
 /// while the frame's budget of their triangles lasts, whose mesh has

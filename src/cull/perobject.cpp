@@ -20,13 +20,6 @@
 namespace occull::detail {
 namespace {
 
-struct PerObjectConfig {
-  std::uint32_t interval = 5;  ///< MAX_FRAMES_WO_OCCLUSION_TESTING
-  bool render_pending = true;
-  bool prepass = true;
-  std::uint64_t threshold = 0;
-};
-
 class PerObjectCuller final : public Culler {
  public:
   PerObjectCuller(const SceneIndex& index, const PerObjectConfig& c)

@@ -14,7 +14,7 @@ namespace {
 
 class PerTileCuller final : public Culler {
  public:
-  PerTileCuller(const SceneIndex& index, const TileCacheConfig& c, const Options& o)
+  PerTileCuller(const SceneIndex& index, const PerTileConfig& c, const Options& o)
       : world_(tiled_world(index, "pertile")), cache_(index, "chcpp", o, c.evict) {}
 
   FrameStats cull(const View& view, Backend& backend) override {
@@ -37,14 +37,14 @@ class PerTileCuller final : public Culler {
 }  // namespace
 
 Registration pertile_registration() {
-  static const ConfigTable<TileCacheConfig> table = ConfigTable<TileCacheConfig>().integer(
-      "evict", &TileCacheConfig::evict, 1, 1000000,
+  static const ConfigTable<PerTileConfig> table = ConfigTable<PerTileConfig>().integer(
+      "evict", &PerTileConfig::evict, 1, 1000000,
       "frames a tile instance may go unused before its BVH instance and CHC++ context are freed");
   return registered({"pertile",
                      "tiled worlds: every tile instance in the frustum culled by its own CHC++ context, nearest first, "
                      "no tile queries (Gomez et al. 2013)",
                      true, {}, false, SceneKind::tiled},
-                    table, [](const SceneIndex& index, const TileCacheConfig& c, const Options& o, const CullerContext&) {
+                    table, [](const SceneIndex& index, const PerTileConfig& c, const Options& o, const CullerContext&) {
                       return std::make_unique<PerTileCuller>(index, c, o);
                     });
 }

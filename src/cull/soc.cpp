@@ -30,14 +30,6 @@
 namespace occull::detail {
 namespace {
 
-struct SocConfig {
-  int scale = 4;   // buffer = viewport / scale on each axis
-  int width = 0;   // explicit buffer size (0: from scale)
-  int height = 0;
-  OccluderChoice occluders;
-  bool simd = true;
-};
-
 using Clock = std::chrono::steady_clock;
 
 class SocCuller final : public Culler {

@@ -11,7 +11,7 @@ namespace {
 
 class StopWaitCuller final : public Culler {
  public:
-  StopWaitCuller(const SceneIndex& index, const CommonOptions& common) : index_(index), common_(common) {}
+  StopWaitCuller(const SceneIndex& index, const QueryOptions& common) : index_(index), common_(common) {}
 
   FrameStats cull(const View& view, Backend& backend) override {
     FrameStats stats;
@@ -47,7 +47,7 @@ class StopWaitCuller final : public Culler {
 
  private:
   SceneIndex index_;
-  CommonOptions common_;
+  QueryOptions common_;
   std::vector<Aabb> boxes_;
   std::vector<ObjectId> objects_;
 };
@@ -55,12 +55,12 @@ class StopWaitCuller final : public Culler {
 }  // namespace
 
 Registration stopwait_registration() {
-  static const ConfigTable<CommonOptions> table =
-      with_common_options(ConfigTable<CommonOptions>(), [](auto& c) -> auto& { return c; });
+  static const ConfigTable<StopWaitConfig> table =
+      with_common_options(ConfigTable<StopWaitConfig>(), &StopWaitConfig::common);
   return registered(
       {"stopwait", "hierarchical stop-and-wait: query every node in the frustum front to back, wait for each"},
-      table, [](const SceneIndex& index, const CommonOptions& c, const Options&, const CullerContext&) {
-        return std::make_unique<StopWaitCuller>(index, c);
+      table, [](const SceneIndex& index, const StopWaitConfig& c, const Options&, const CullerContext&) {
+        return std::make_unique<StopWaitCuller>(index, c.common);
       });
 }
 

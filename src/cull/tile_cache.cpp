@@ -2,7 +2,6 @@
 #include "tile_cache.hpp"
 
 #include "occull/error.hpp"
-
 #include "core/format.hpp"
 
 #include <algorithm>

@@ -22,11 +22,6 @@ struct TileInstance {
   std::uint64_t last_used = 0;        ///< frame it was last fetched in
 };
 
-/// The options of a tiled-world culler that has nothing but its cache to set.
-struct TileCacheConfig {
-  int evict = 60;  ///< frames a tile instance may go unused before it is freed
-};
-
 class TileCache {
  public:
   /// `local`: the algorithm culling inside a tile ("chcpp"), or empty for

@@ -35,14 +35,6 @@
 namespace occull::detail {
 namespace {
 
-struct TilesConfig {
-  std::string local = "chcpp";  // culler inside a visible tile (empty: draw the whole tile)
-  int evict = 60;
-  int neighbors = 8;
-  std::uint32_t requery = 1;
-  bool common_box = true;
-};
-
 class TilesCuller final : public Culler {
  public:
   TilesCuller(const SceneIndex& index, const TilesConfig& c, const Options& o)

@@ -13,7 +13,7 @@ namespace {
 
 class TileVfcCuller final : public Culler {
  public:
-  TileVfcCuller(const SceneIndex& index, const TileCacheConfig& c, const Options& o)
+  TileVfcCuller(const SceneIndex& index, const TileVfcConfig& c, const Options& o)
       : index_(index), world_(tiled_world(index, "tilevfc")), cache_(index, "", o, c.evict) {}
 
   FrameStats cull(const View& view, Backend& backend) override {
@@ -45,14 +45,14 @@ class TileVfcCuller final : public Culler {
 }  // namespace
 
 Registration tilevfc_registration() {
-  static const ConfigTable<TileCacheConfig> table = ConfigTable<TileCacheConfig>().integer(
-      "evict", &TileCacheConfig::evict, 1, 1000000,
+  static const ConfigTable<TileVfcConfig> table = ConfigTable<TileVfcConfig>().integer(
+      "evict", &TileVfcConfig::evict, 1, 1000000,
       "frames a tile instance may go unused before its BVH instance is freed");
   return registered({"tilevfc",
                      "tiled worlds: view-frustum culling over the BVH of every tile instance in the frustum, nearest "
                      "tile first (Gomez et al. 2013's baseline)",
                      true, {}, false, SceneKind::tiled},
-                    table, [](const SceneIndex& index, const TileCacheConfig& c, const Options& o, const CullerContext&) {
+                    table, [](const SceneIndex& index, const TileVfcConfig& c, const Options& o, const CullerContext&) {
                       return std::make_unique<TileVfcCuller>(index, c, o);
                     });
 }

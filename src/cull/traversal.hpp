@@ -249,13 +249,6 @@ void collect_in_frustum_front_to_back(const SceneIndex& index, const View& view,
 void append_objects_in_frustum(const SceneIndex& index, NodeId n, const View& view,
                                std::vector<ObjectId>& out, std::uint32_t planes = Frustum::all_planes);
 
-/// How a node's occlusion query is shaped.
-struct QueryShape {
-  bool tight = false;  ///< children's boxes (Bittner et al. 2009 "tighter bounding volumes")
-  int d_max = 3;
-  float s_max = 1.4f;
-};
-
 /// Appends the boxes of node `n`'s query.
 inline void append_query_boxes(const SceneIndex& index, NodeId n, const QueryShape& shape,
                                std::vector<Aabb>& out) {
@@ -265,19 +258,12 @@ inline void append_query_boxes(const SceneIndex& index, NodeId n, const QuerySha
     out.push_back(index.bvh.node(n).bounds);
 }
 
-/// Options every hierarchical query culler shares.
-struct CommonOptions {
-  std::uint64_t threshold = 0;           ///< a node is visible when more samples pass
-  std::uint32_t virtual_leaf_triangles = 0;
-  bool cpu_test = false;                 ///< ask a CPU occlusion buffer before each query (CpuTestBackend)
-};
-
 /// A query culler whose frames run through the CPU first test when its
-/// options ask for it (CommonOptions::cpu_test; occull/cpu_test_backend.hpp):
+/// options ask for it (QueryOptions::cpu_test; occull/cpu_test_backend.hpp):
 /// the culler's cull_frame() sees a CpuTestBackend over the frame's backend.
 class CpuTestedCuller : public Culler, public Resumable {
  public:
-  CpuTestedCuller(const SceneIndex& index, const CommonOptions& options)
+  CpuTestedCuller(const SceneIndex& index, const QueryOptions& options)
       : cpu_test_(options.cpu_test ? std::make_unique<CpuTestBackend>(index.scene) : nullptr) {}
 
   FrameStats cull(const View& view, Backend& backend) final {
@@ -321,7 +307,7 @@ class CpuTestedCuller : public Culler, public Resumable {
   bool resume_ = false;
 };
 
-/// Adds the fields of the CommonOptions at `at` (see ConfigTable) to `table`.
+/// Adds the fields of the QueryOptions at `at` (see ConfigTable) to `table`.
 template <class Config, class At>
 ConfigTable<Config>&& with_common_options(ConfigTable<Config>&& table, At at) {
   return std::move(table)

@@ -30,9 +30,9 @@ class VfcCuller final : public Culler {
 }  // namespace
 
 Registration vfc_registration() {
-  static const ConfigTable<NoOptions> table;
+  static const ConfigTable<VfcConfig> table;
   return registered({"vfc", "hierarchical view-frustum culling over the BVH, front to back"}, table,
-                    [](const SceneIndex& index, const NoOptions&, const Options&, const CullerContext&) {
+                    [](const SceneIndex& index, const VfcConfig&, const Options&, const CullerContext&) {
                       return std::make_unique<VfcCuller>(index);
                     });
 }

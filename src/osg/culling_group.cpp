@@ -114,7 +114,7 @@ OcclusionCullingGroup::OcclusionCullingGroup(std::string algorithm, Options opti
 
 // A copy culls the same subgraph with its own scene and cullers.
 OcclusionCullingGroup::OcclusionCullingGroup(const OcclusionCullingGroup& g, const ::osg::CopyOp& op)
-    : ::osg::Group(g, op), algorithm_(g.algorithm_), options_(g.options_), context_(g.context_) {
+    : ::osg::Group(g, op), algorithm_(g.algorithm_), make_(g.make_), context_(g.context_) {
   start();
 }
 
@@ -136,18 +136,26 @@ void OcclusionCullingGroup::start() {
 OcclusionCullingGroup::~OcclusionCullingGroup() = default;
 
 void OcclusionCullingGroup::set_algorithm(std::string algorithm, Options options) {
-  // Checked now, on an empty scene: an unknown name or option throws here.
+  (void)parse_algorithm_spec(algorithm, options);  // throws for an unknown name, listing the valid ones
+  Maker make = [spec = algorithm, options = std::move(options)](const SceneIndex& index, const CullerContext& context) {
+    return make_culler(spec, index, options, context);
+  };
+  set_maker(std::move(algorithm), std::move(make));
+}
+
+void OcclusionCullingGroup::set_maker(std::string algorithm, Maker make) {
+  // Checked now, on an empty scene: an unknown option or a value out of range throws here.
   Scene empty;
   const Bvh bvh = Bvh::build(empty);
-  (void)make_culler(algorithm, {empty, bvh}, options, context_);
-  const AlgorithmSpec spec = parse_algorithm_spec(algorithm, options);
-  if (find_algorithm(spec.name).device)
+  (void)make({empty, bvh}, context_);
+  const std::string name = algorithm.substr(0, algorithm.find(':'));
+  if (find_algorithm(name).device)
     throw InputError(fmt::format("{} culls on the device, and the group's backend over osg::State has no device "
                                  "culling (DeviceCulling); use a culler that issues queries",
-                                 spec.name));
+                                 name));
   std::lock_guard lock(mutex_);
   algorithm_ = std::move(algorithm);
-  options_ = std::move(options);
+  make_ = std::move(make);
 }
 
 const Scene& OcclusionCullingGroup::scene() const noexcept { return state_->scene; }
@@ -260,7 +268,7 @@ void OcclusionCullingGroup::draw(::osg::RenderInfo& info) {
   const ::osg::Camera* camera = info.getCurrentCamera();
   CameraCuller& c = s.cameras[camera];
   if (!c.culler) {
-    c.culler = make_culler(algorithm_, {s.scene, s.bvh}, options_, context_);
+    c.culler = make_({s.scene, s.bvh}, context_);
     c.backend = std::make_unique<detail::OsgBackend>(state.getContextID());
     c.context_id = state.getContextID();
   }

@@ -58,6 +58,7 @@
 #include <osgViewer/ViewerBase>
 
 #include <memory>
+#include <functional>
 #include <mutex>
 #include <span>
 #include <string>
@@ -112,12 +113,33 @@ class OcclusionCullingGroup : public ::osg::Group {
   /// here: throws occull::InputError for an unknown one, listing the valid names.
   explicit OcclusionCullingGroup(std::string algorithm = "chcpp", occull::Options options = {},
                                  occull::CullerContext context = {});
+  /// Cullers made per camera from a typed config (occull/configs.hpp; a
+  /// misspelt field does not compile): `OcclusionCullingGroup(
+  /// occull::ChcppConfig{.batch = 20})`. Throws occull::InputError for a
+  /// value outside its range, or a culler that needs device culling.
+  template <class Config>
+    requires requires { Config::algorithm; }
+  explicit OcclusionCullingGroup(const Config& config, occull::CullerContext context = {})
+      : context_(std::move(context)) {
+    set_config(config);
+    start();
+  }
   OcclusionCullingGroup(const OcclusionCullingGroup&, const ::osg::CopyOp& = ::osg::CopyOp::SHALLOW_COPY);
   META_Node(occull, OcclusionCullingGroup)
 
   /// The algorithm of the cullers made from now on (cameras seen before keep
   /// theirs until releaseGLObjects). Throws occull::InputError as the constructor.
   void set_algorithm(std::string algorithm, occull::Options options = {});
+  /// The typed config of the cullers made from now on, as set_algorithm().
+  template <class Config>
+    requires requires { Config::algorithm; }
+  void set_config(const Config& config) {
+    set_maker(std::string(Config::algorithm),
+              [config](const occull::SceneIndex& index, const occull::CullerContext& context) {
+                return occull::make_culler(config, index, context);
+              });
+  }
+  /// The spec of set_algorithm(), or the algorithm of set_config().
   [[nodiscard]] const std::string& algorithm() const noexcept { return algorithm_; }
 
   void traverse(::osg::NodeVisitor& nv) override;
@@ -147,14 +169,18 @@ class OcclusionCullingGroup : public ::osg::Group {
   struct State;       // the scene, hierarchy and per-camera cullers
   class Drawer;       // the drawable filed in the cull traversal; runs the culler in the draw
   friend class Drawer;
+  // Makes a camera's culler over the group's scene.
+  using Maker = std::function<std::unique_ptr<occull::Culler>(const occull::SceneIndex&, const occull::CullerContext&)>;
   std::string algorithm_;
-  occull::Options options_;
+  Maker make_;
   occull::CullerContext context_;
   std::vector<Instance> instances_;
   std::shared_ptr<State> state_;
   ::osg::ref_ptr<::osg::Geode> drawer_geode_;
   std::mutex mutex_;  // gathering and per-camera state: cull and draw threads of several contexts
   void start();  // an empty scene, no cullers yet, the group's drawable
+  // Checks `make` on an empty scene (its name: `algorithm`) and keeps it for the cullers made from now on.
+  void set_maker(std::string algorithm, Maker make);
   void gather(unsigned frame_number);
   void draw(::osg::RenderInfo& info);
 };
