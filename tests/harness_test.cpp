@@ -248,16 +248,6 @@ TEST(Verdict, MissesOfConservativeRunsFailThoseOfOthersArePopping) {
   EXPECT_TRUE(verification_failures(r).empty());
 }
 
-TEST(Summarize, MeanMedianPercentileMax) {
-  std::vector<double> v;
-  for (int i = 1; i <= 100; ++i) v.push_back(i);
-  const Summary s = summarize(v);
-  EXPECT_DOUBLE_EQ(s.mean, 50.5);
-  EXPECT_DOUBLE_EQ(s.median, 50.5);
-  EXPECT_DOUBLE_EQ(s.p95, 95.0);
-  EXPECT_DOUBLE_EQ(s.max, 100.0);
-}
-
 TEST(GroundTruth, WallHidesTheBoxBehindItNotTheOneBeside) {
   auto context = gl::Context::create();
   const Scene scene = test::box_scene({{{-3, -3, -11}, {3, 3, -10}},   // wall

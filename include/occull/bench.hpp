@@ -4,6 +4,7 @@
 #pragma once
 
 #include "occull/session.hpp"
+#include "occull/statistics.hpp"
 
 #include <span>
 #include <string>
@@ -45,11 +46,6 @@ struct BenchConfig {
   FaultHooks hooks;                       ///< tests only: break a step on purpose (see FaultHooks)
 };
 
-/// Mean, median, 95th percentile and maximum of a sample (all 0 when empty).
-struct Summary {
-  double mean = 0.0, median = 0.0, p95 = 0.0, max = 0.0;
-};
-[[nodiscard]] Summary summarize(std::vector<double> values);
 
 /// One algorithm over all repeats. Timings and per-frame means are the
 /// median over repeats of each repeat's figure (ratios are taken within a

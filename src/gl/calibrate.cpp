@@ -1,6 +1,7 @@
 #include "occull/gl/calibrate.hpp"
 
 #include "occull/gl/renderer.hpp"
+#include "occull/statistics.hpp"
 
 #include <fmt/format.h>
 #include <glm/gtc/matrix_transform.hpp>
@@ -54,12 +55,8 @@ struct Median {
 };
 
 Median median_of(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  Median m;
-  m.value = v[v.size() / 2];
-  if (v.size() % 2 == 0) m.value = 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
-  m.spread = m.value != 0.0 ? (v.back() - v.front()) / std::abs(m.value) : 0.0;
-  return m;
+  const Summary s = summarize(std::move(v));
+  return {s.median, s.median != 0.0 ? (s.max - s.min) / std::abs(s.median) : 0.0};
 }
 
 constexpr int kFullQuads = 6;  // full-screen quads per fragment measurement

@@ -16,24 +16,6 @@ namespace {
 
 double median_of(std::vector<double> v) { return summarize(std::move(v)).median; }
 
-}  // namespace
-
-Summary summarize(std::vector<double> v) {
-  Summary s;
-  if (v.empty()) return s;
-  std::sort(v.begin(), v.end());
-  s.mean = std::accumulate(v.begin(), v.end(), 0.0) / double(v.size());
-  const std::size_t n = v.size();
-  s.median = n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-  // Nearest-rank percentile.
-  const auto rank = std::size_t(std::ceil(0.95 * double(n)));
-  s.p95 = v[std::min(n, std::max<std::size_t>(rank, 1)) - 1];
-  s.max = v.back();
-  return s;
-}
-
-namespace {
-
 // One repeat's figure of a counter from the sum, the largest value and the
 // number of its frames (Counter::frames).
 double run_figure(const Counter& c, double sum, double largest, double frames) {

@@ -3,7 +3,7 @@
 // that can cover a texel from where the camera is), with the vectorised
 // inner loops and with the scalar reference. Buffers are cleared between
 // frames, nothing is tested: this is the rasterizer's throughput alone.
-#include "raster_bench.hpp"
+#include "cli.hpp"
 
 #include "occull/error.hpp"
 #include "occull/input_limits.hpp"
@@ -21,13 +21,20 @@
 namespace occull::app {
 namespace {
 
+struct RasterArgs {
+  std::string scene = "city";
+  std::string path;  // empty: the scene's first
+  std::string sizes = "320x180,1280x720";
+  int frames = 50;
+  int repeat = 5;
+  double detail = 8.0;  // as soc.detail
+};
+
 struct Job {
   const Mesh* mesh;
   const OccluderMesh* occluder;
   const Object* object;
 };
-
-}  // namespace
 
 int cmd_raster(const RasterArgs& a) {
   if (a.frames < 1) throw InputError("--frames must be at least 1");
@@ -107,6 +114,24 @@ int cmd_raster(const RasterArgs& a) {
              "polygons: rasterized per frame (front-facing, in the buffer, wide enough to cover a texel); ms: per "
              "frame; p/ms: polygons per millisecond\n");
   return 0;
+}
+
+}  // namespace
+
+Command add_raster(CLI::App& app) {
+  auto a = std::make_shared<RasterArgs>();
+  auto* ra = app.add_subcommand("raster",
+                                "time the CPU occlusion buffer's rasterizer (soc) on one core over the occluders a "
+                                "camera path sees: vectorised against the scalar reference, polygons per millisecond");
+  ra->add_option("--scene", a->scene, "scene spec (see occull scenes)")->capture_default_str();
+  ra->add_option("--path", a->path, "camera path (default: the scene's first)");
+  ra->add_option("--sizes", a->sizes, "comma-separated buffer sizes WIDTHxHEIGHT")->capture_default_str();
+  ra->add_option("--frames", a->frames, "frames spread over the path")->capture_default_str();
+  ra->add_option("--repeat", a->repeat, "timings of each frame; the fastest counts")->capture_default_str();
+  ra->add_option("--detail", a->detail, "as soc.detail: polygons below 1/detail of their mesh's largest "
+                                            "inscribed circle left out (0: all)")
+      ->capture_default_str();
+  return [a] { return cmd_raster(*a); };
 }
 
 }  // namespace occull::app
