@@ -213,3 +213,17 @@ TEST(MakeSplitScreen, AlgorithmsThatShareViewsMakeThemTogetherTheOthersOnePerVie
   EXPECT_THROW((void)make_split_screen("grid:nope=1", {scene, bvh}, 2), InputError);
   EXPECT_THROW((void)make_split_screen("oracle", {scene, bvh}, 2), InputError);  // harness only
 }
+
+TEST(Culler, HizOverABackendWithoutDeviceCullingIsTheCallersMistake) {
+  const Scene scene = test::box_scene(test::scattered_boxes(5));
+  const Bvh bvh = Bvh::build(scene);
+  auto hiz = make_culler("hiz", {scene, bvh});  // made: the backend comes with the frame
+  test::ScriptedBackend backend;  // no DeviceCulling
+  const View view = test::unsampled(make_view({{0, 0, 0}, 0, 0}, {70.0f, 0.1f, 500.0f}, 64, 64));
+  try {
+    (void)hiz->render_frame(view, backend);
+    FAIL() << "hiz culled over a backend without device culling";
+  } catch (const UsageError& e) {
+    EXPECT_NE(std::string(e.what()).find("no device culling"), std::string::npos) << e.what();
+  }
+}

@@ -119,19 +119,24 @@ TEST(Scene, BadEngineCallsAreRefusedAndChangeNothing) {
   glm::mat4 nan = glm::mat4(1.0f);
   nan[3][0] = std::nanf("");
   EXPECT_THROW(s.set_transform(0, nan), InputError);
-  EXPECT_THROW(s.set_transform(7, glm::mat4(1.0f)), InputError);
-  EXPECT_THROW(s.remove_object(7), InputError);
-  EXPECT_THROW((void)s.add_object(9, 0, glm::mat4(1.0f), OccluderClass::never), InputError);
-  EXPECT_THROW((void)s.add_object(0, 9, glm::mat4(1.0f), OccluderClass::never), InputError);
+  EXPECT_THROW(s.set_transform(7, glm::mat4(1.0f)), UsageError);
+  EXPECT_THROW(s.remove_object(7), UsageError);
+  EXPECT_THROW((void)s.add_object(9, 0, glm::mat4(1.0f), OccluderClass::never), UsageError);
+  EXPECT_THROW((void)s.add_object(0, 9, glm::mat4(1.0f), OccluderClass::never), UsageError);
   EXPECT_THROW((void)s.add_object(0, 0, nan, OccluderClass::never), InputError);
   s.remove_object(0);
   try {
     s.set_transform(0, glm::mat4(1.0f));
     FAIL() << "a removed object moved";
-  } catch (const InputError& e) {
+  } catch (const UsageError& e) {
     EXPECT_NE(std::string(e.what()).find("object 0: it was removed"), std::string::npos) << e.what();
   }
-  EXPECT_THROW(s.remove_object(0), InputError);
+  EXPECT_THROW(s.remove_object(0), UsageError);
+  EXPECT_THROW(s.place_object(0, 0, 0, glm::mat4(1.0f), OccluderClass::never), UsageError);  // removed
+  Mesh past_its_positions = test::box_mesh({{0, 0, 0}, {1, 1, 1}});
+  past_its_positions.indices.back() = std::uint32_t(past_its_positions.positions.size());
+  EXPECT_THROW((void)s.add_mesh(past_its_positions), UsageError);
+  EXPECT_EQ(s.meshes().size(), 1u);
   EXPECT_EQ(s.objects().size(), 1u);
   EXPECT_EQ(s.placement_revision(), revision + 1);  // the one removal
   (void)before;

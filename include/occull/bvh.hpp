@@ -51,7 +51,8 @@ class Bvh {
   [[nodiscard]] static Bvh build(const Scene& scene, const BvhOptions& options = {});
   /// Builds over bare boxes: object i has box `bounds[i]` and `triangles[i]`
   /// triangles, and every object is static (a tile's local objects, built
-  /// once and instanced). Precondition: both spans have the same size.
+  /// once and instanced). Throws UsageError unless both spans have the same
+  /// size and options.max_leaf_objects >= 1.
   [[nodiscard]] static Bvh build(std::span<const Aabb> bounds, std::span<const std::uint32_t> triangles,
                                  const BvhOptions& options = {});
   /// A copy moved by `offset` (scene units) whose leaves name object

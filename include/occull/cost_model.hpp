@@ -33,7 +33,8 @@ struct HardwareProfile {
   double query_overhead_ms = 0.0;    ///< T_o^o: a query issued along with rendering, over rendering alone
 
   /// T_r^f for a shading cost: the measured class, or linear interpolation /
-  /// extrapolation between the nearest measured ones. Precondition: non-empty fragment_ms.
+  /// extrapolation between the nearest measured ones. Throws UsageError for an
+  /// empty fragment_ms.
   [[nodiscard]] double fragment_cost(int shading_cost) const;
   /// N_q = ceil(T_o^l / min(T_o^s, T_o^o + T_r^s)) + 1: queries that can be in
   /// flight before the first one must have finished.

@@ -204,7 +204,7 @@ struct AlgorithmInfo {
   /// and one query cap), so make_split_screen() makes them together.
   bool shares_views = false;
   /// Culls on the device (`hiz`): its backend must offer DeviceCulling
-  /// (Backend::device_culling()), and render_frame() throws InputError on
+  /// (Backend::device_culling()), and render_frame() throws UsageError on
   /// one that does not.
   bool device = false;
   /// Occludes only with the triangles of meshes whose vertices the scene

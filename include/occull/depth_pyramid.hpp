@@ -97,7 +97,8 @@ class DepthPyramid {
  public:
   /// `depth`: width*height window depths as the device stores them (with
   /// reversed-Z, larger is nearer), row-major, bottom row first (level 0).
-  /// Preconditions: width, height >= 1; depth.size() == width*height.
+  /// Throws UsageError unless width, height >= 1 and depth.size() ==
+  /// width*height.
   DepthPyramid(std::span<const float> depth, int width, int height, bool reversed_z,
                const PyramidRules& rules = {});
 

@@ -6,12 +6,24 @@
 
 namespace occull {
 
-/// Bad input from a user: an unknown name, an invalid number, a corrupt file.
-/// The message says what is wrong and, for names, lists the valid ones.
-/// Tools map it to exit code 2.
+/// Bad input from a user: an unknown name, an invalid number, a corrupt file,
+/// and values that can come from such input (a non-finite transform, a count
+/// past occull::limits). The message says what is wrong and, for names,
+/// lists the valid ones. Tools map it to exit code 2.
 class InputError : public std::runtime_error {
  public:
   using std::runtime_error::runtime_error;
+};
+
+/// A caller broke a documented precondition of occull's API: an id that
+/// does not exist, a query not in flight, calls out of their order, a size
+/// out of range. A bug in the calling program, not in its input: the message
+/// names the call and the precondition. Checked wherever the check costs
+/// little beside the call, never by assert alone (docs/library.md, "Errors").
+/// Tools map it to exit code 1.
+class UsageError : public std::logic_error {
+ public:
+  using std::logic_error::logic_error;
 };
 
 /// The platform cannot run the OpenGL reference renderer (no EGL display, no
@@ -31,11 +43,12 @@ class InvariantViolation : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-/// An OpenGL call failed, as the driver's debug output reported it (a
-/// context created with ContextOptions::debug, occull --gl-debug, or any
-/// context of a debug build): a bug in occull or in the driver. The message
-/// names the phase, the driver's report and the call stack of the failing
-/// call. Tools map it to exit code 1.
+/// An OpenGL call failed: the driver's debug output reported it (a context
+/// created with ContextOptions::debug, occull --gl-debug, or any context of a
+/// debug build; the message names the phase, the driver's report and the
+/// call stack), the GL error flag was set, a shader did not compile or link,
+/// or a framebuffer is incomplete. A bug in occull or in the driver. Tools
+/// map it to exit code 1.
 class GlError : public std::runtime_error {
  public:
   using std::runtime_error::runtime_error;

@@ -155,7 +155,7 @@ class OcclusionBuffer {
  public:
   static constexpr int tile_size = 8;  ///< texels per tile side
 
-  /// Preconditions: 1 <= width, height <= 8192.
+  /// Throws UsageError unless 1 <= width, height <= 8192.
   OcclusionBuffer(int width, int height, SimdPath simd = SimdPath::best, const OcclusionRules& rules = {});
 
   [[nodiscard]] int width() const noexcept { return width_; }
@@ -169,11 +169,13 @@ class OcclusionBuffer {
   /// Rasterizes the triangles `indices` (3 per triangle) of `positions`,
   /// transformed by `object_to_clip` (view_proj * object transform), into
   /// the buffer. Returns the triangles rasterized (front-facing, not clipped
-  /// away entirely, not degenerate). Precondition: indices < positions.size().
+  /// away entirely, not degenerate). Throws UsageError for an index past
+  /// positions.size().
   std::uint32_t rasterize(std::span<const glm::vec3> positions, std::span<const std::uint32_t> indices,
                           const glm::dmat4& object_to_clip);
   /// Rasterizes the first `count` polygons of `mesh` (made from `positions`).
-  /// Returns the polygons rasterized. Precondition: count <= mesh.polygons().
+  /// Returns the polygons rasterized. Throws UsageError for count >
+  /// mesh.polygons().
   std::uint32_t rasterize(std::span<const glm::vec3> positions, const OccluderMesh& mesh, std::size_t count,
                           const glm::dmat4& object_to_clip);
   /// Rasterizes the polygons of an object's `mesh` that can cover a texel

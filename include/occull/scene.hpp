@@ -101,27 +101,28 @@ class Scene {
  public:
   explicit Scene(std::string name = {}, const SceneLimits& caps = {}) : name_(std::move(name)), caps_(caps) {}
 
-  /// Adds a mesh. Precondition: indices in range, normals.size() == positions.size().
-  /// Throws InputError past SceneLimits::mesh_triangles triangles in all meshes.
+  /// Adds a mesh. Throws UsageError unless every index is in range, there
+  /// are 3 per triangle and one normal per position; InputError past
+  /// SceneLimits::mesh_triangles triangles in all meshes.
   MeshId add_mesh(Mesh mesh);
   /// Adds a mesh the engine keeps itself: bounds, triangle count and area,
   /// no vertices. Throws InputError for bounds or an area that is not finite.
   MeshId add_mesh(const MeshInfo& info);
   MaterialId add_material(Material material);
   /// Adds a static object, in the slot of the most recently removed object
-  /// if there is one. Throws InputError for a mesh or material that does not
-  /// exist, a transform that is not finite, or past SceneLimits::objects
-  /// objects; the scene is unchanged then.
+  /// if there is one. Throws UsageError for a mesh or material that does not
+  /// exist; InputError for a transform that is not finite, or past
+  /// SceneLimits::objects objects; the scene is unchanged then.
   ObjectId add_object(MeshId mesh, MaterialId material, const glm::mat4& transform,
                       OccluderClass occluder);
   /// Sets object `id`'s object-to-world transform; its bounds follow. Any
   /// object, static or dynamic (a dynamic one's next update() puts it back
-  /// on its Motion). Throws InputError, the scene unchanged, for an id that
-  /// does not exist or was removed, or a transform with an entry that is not
-  /// finite.
+  /// on its Motion). Throws, the scene unchanged, UsageError for an id that
+  /// does not exist or was removed, InputError for a transform with an entry
+  /// that is not finite.
   void set_transform(ObjectId id, const glm::mat4& transform);
   /// Removes object `id` (static or dynamic): it keeps the id with empty
-  /// bounds and no triangles until add_object() reuses it. Throws InputError,
+  /// bounds and no triangles until add_object() reuses it. Throws UsageError,
   /// the scene unchanged, for an id that does not exist or was removed.
   void remove_object(ObjectId id);
   /// Whether `id` is an object that was not removed.
@@ -151,21 +152,23 @@ class Scene {
   }
   /// Adds a dynamic object that follows `motion` (its transform at time 0 is
   /// applied at once). `local` is applied before the motion's transform.
+  /// Throws as add_object(), and InputError for a motion without 2 finite
+  /// waypoints and a finite speed > 0.
   ObjectId add_dynamic_object(MeshId mesh, MaterialId material, Motion motion,
                               OccluderClass occluder, const glm::mat4& local = glm::mat4(1.0f));
 
   /// Replaces motion `index` of motions(): the dynamic objects on it follow
   /// the new one from their next update() (an engine that re-routes them, or
-  /// moves its floating origin). Throws InputError, the scene unchanged, for
-  /// an index out of range or a motion without 2 finite waypoints and a
-  /// finite speed > 0.
+  /// moves its floating origin). Throws, the scene unchanged, UsageError for
+  /// an index out of range, InputError for a motion without 2 finite
+  /// waypoints and a finite speed > 0.
   void set_motion(std::size_t index, Motion motion);
 
   /// Makes static object `id` another object in place: its mesh, material,
   /// transform and class (a tiled world reuses the ids of a tile that left
   /// its window for the one that entered). Bounds and triangles follow.
-  /// Records `id` in moved_objects(). Preconditions: `id` exists and is
-  /// static; mesh and material exist.
+  /// Records `id` in moved_objects(). Throws UsageError unless `id` exists
+  /// and is static and mesh and material exist.
   void place_object(ObjectId id, MeshId mesh, MaterialId material, const glm::mat4& transform,
                     OccluderClass occluder);
   /// Objects placed, moved, added or removed since the last clear_moved(),
@@ -216,7 +219,9 @@ class Scene {
   std::uint64_t moved_from_revision_ = 0;  // moved_ lists every change after this revision
   // Records a change of object `id`'s placement.
   void note_moved(ObjectId id);
+  // Throw UsageError for an object that is not there, InputError for a motion that is not finite.
   void check_object(ObjectId id, const char* what) const;
+  void check_motion(const Motion& motion, const char* what) const;
   // A static object of `mesh` at `transform`, its bounds and triangles filled.
   [[nodiscard]] Object make_object(MeshId mesh, MaterialId material, const glm::mat4& transform,
                                    OccluderClass occluder) const;

@@ -157,7 +157,8 @@ class CameraPath {
   };
 
   CameraPath() = default;
-  /// Preconditions: keys non-empty, times strictly increasing.
+  /// Throws UsageError without keys. Precondition: times strictly
+  /// increasing.
   CameraPath(std::string name, std::string description, std::vector<Key> keys);
 
   [[nodiscard]] const std::string& name() const noexcept { return name_; }

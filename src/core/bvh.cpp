@@ -1,4 +1,6 @@
 #include "occull/bvh.hpp"
+#include "occull/error.hpp"
+#include "core/format.hpp"
 
 #include <algorithm>
 #include <functional>
@@ -151,7 +153,8 @@ class Builder {
 }  // namespace
 
 Bvh Bvh::build(const Scene& scene, const BvhOptions& options) {
-  assert(options.max_leaf_objects >= 1);
+  if (options.max_leaf_objects < 1)
+    throw UsageError(detail::format("Bvh::build: max_leaf_objects {} (at least 1)", options.max_leaf_objects));
   Bvh bvh;
   const auto objects = scene.objects();
   std::vector<BuildItem> items;
@@ -192,7 +195,10 @@ void Bvh::finish_build() {
 
 Bvh Bvh::build(std::span<const Aabb> bounds, std::span<const std::uint32_t> triangles,
                const BvhOptions& options) {
-  assert(options.max_leaf_objects >= 1 && bounds.size() == triangles.size());
+  if (options.max_leaf_objects < 1 || bounds.size() != triangles.size())
+    throw UsageError(detail::format("Bvh::build: max_leaf_objects {} (at least 1), {} boxes and {} triangle counts "
+                                    "(one per box)",
+                                    options.max_leaf_objects, bounds.size(), triangles.size()));
   Bvh bvh;
   std::vector<BuildItem> items;
   items.reserve(bounds.size());

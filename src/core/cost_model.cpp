@@ -1,4 +1,5 @@
 #include "occull/cost_model.hpp"
+#include "occull/error.hpp"
 
 #include <algorithm>
 #include <cassert>
@@ -7,7 +8,7 @@
 namespace occull {
 
 double HardwareProfile::fragment_cost(int shading_cost) const {
-  assert(!fragment_ms.empty());
+  if (fragment_ms.empty()) throw UsageError("HardwareProfile::fragment_cost: the profile has no fragment costs");
   const auto hit = fragment_ms.find(shading_cost);
   if (hit != fragment_ms.end()) return hit->second;
   if (fragment_ms.size() == 1) return fragment_ms.begin()->second;

@@ -1,6 +1,8 @@
 // The depth pyramid's reference implementation: see depth_pyramid.hpp for
 // the rules. src/gl/renderer_device.cpp's shaders follow this file.
 #include "occull/depth_pyramid.hpp"
+#include "occull/error.hpp"
+#include "core/format.hpp"
 
 #include <glm/vec4.hpp>
 
@@ -54,7 +56,8 @@ int pyramid_level_for(int extent) noexcept {
 DepthPyramid::DepthPyramid(std::span<const float> depth, int width, int height, bool reversed_z,
                            const PyramidRules& rules)
     : reversed_(reversed_z), rules_(rules) {
-  assert(width >= 1 && height >= 1 && depth.size() == std::size_t(width) * std::size_t(height));
+  if (width < 1 || height < 1 || depth.size() != std::size_t(width) * std::size_t(height))
+    throw UsageError(detail::format("DepthPyramid: {} depth values for {}x{} texels", depth.size(), width, height));
   levels_.push_back({width, height, std::vector<float>(depth.begin(), depth.end())});
   while (levels_.back().width > 1 || levels_.back().height > 1) {
     const Level& src = levels_.back();
@@ -83,7 +86,8 @@ float DepthPyramid::at(int level, int x, int y) const {
 }
 
 bool DepthPyramid::occluded(const Aabb& box, const glm::mat4& view_proj, const ClipSpace& clip, int texels) const {
-  assert(texels == 2 || texels == 4 || texels == 8 || texels == 16);
+  if (texels != 2 && texels != 4 && texels != 8 && texels != 16)
+    throw UsageError(detail::format("DepthPyramid::occluded: {} texels per axis (2, 4, 8 or 16)", texels));
   if (box.empty()) return true;  // nothing to draw
   const Level& base = levels_.front();
   const BoxFootprint f = project_box(box, view_proj, clip, base.width, base.height);

@@ -4,6 +4,8 @@
 
 #include "occull/depth_pyramid.hpp"  // depth_tolerance: the same margin as the pyramid's
 #include "occlusion_buffer_simd.hpp"
+#include "occull/error.hpp"
+#include "core/format.hpp"
 
 #include <algorithm>
 #include <array>
@@ -199,7 +201,8 @@ OcclusionBuffer::OcclusionBuffer(int width, int height, SimdPath simd, const Occ
       keys_(std::size_t(width) * std::size_t(height), kInf),
       tile_far_(std::size_t(tiles_x_) * std::size_t(tiles_y_), kInf),
       tile_dirty_(tile_far_.size(), 0) {
-  assert(width >= 1 && height >= 1 && width <= 8192 && height <= 8192);
+  if (width < 1 || height < 1 || width > 8192 || height > 8192)
+    throw UsageError(detail::format("OcclusionBuffer: {}x{} texels (each side in [1, 8192])", width, height));
 }
 
 void OcclusionBuffer::clear(const ClipSpace& clip) {
@@ -219,7 +222,9 @@ std::uint32_t OcclusionBuffer::rasterize(std::span<const glm::vec3> positions, s
   for (std::size_t i = 0; i + 2 < indices.size(); i += 3) {
     glm::dvec4 c[3];
     for (int k = 0; k < 3; ++k) {
-      assert(indices[i + std::size_t(k)] < positions.size());
+      if (indices[i + std::size_t(k)] >= positions.size())
+        throw UsageError(detail::format("OcclusionBuffer::rasterize: index {} of {} positions",
+                                        indices[i + std::size_t(k)], positions.size()));
       c[k] = object_to_clip * glm::dvec4(glm::dvec3(positions[indices[i + std::size_t(k)]]), 1.0);
     }
     raster_clipped(c, 3, count);
@@ -229,7 +234,8 @@ std::uint32_t OcclusionBuffer::rasterize(std::span<const glm::vec3> positions, s
 
 std::uint32_t OcclusionBuffer::rasterize(std::span<const glm::vec3> positions, const OccluderMesh& mesh,
                                          std::size_t count, const glm::dmat4& object_to_clip) {
-  assert(count <= mesh.polygons());
+  if (count > mesh.polygons())
+    throw UsageError(detail::format("OcclusionBuffer::rasterize: {} polygons of a mesh of {}", count, mesh.polygons()));
   std::uint32_t drawn = 0;
   for (std::size_t p = 0; p < count; ++p) {
     raster_mesh_polygon(positions, mesh, p, object_to_clip, drawn);

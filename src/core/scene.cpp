@@ -54,7 +54,14 @@ glm::mat4 Motion::transform_at(double time_s) const {
 }
 
 MeshId Scene::add_mesh(Mesh mesh) {
-  assert(mesh.normals.size() == mesh.positions.size());
+  if (mesh.normals.size() != mesh.positions.size() || mesh.indices.size() % 3 != 0)
+    throw UsageError(detail::format("scene {}: add_mesh: {} normals for {} positions and {} indices (one normal per "
+                                    "position, 3 indices per triangle)",
+                                    name_, mesh.normals.size(), mesh.positions.size(), mesh.indices.size()));
+  for (const std::uint32_t i : mesh.indices)
+    if (i >= mesh.positions.size())
+      throw UsageError(detail::format("scene {}: add_mesh: index {} of a mesh of {} positions", name_, i,
+                                      mesh.positions.size()));
   if (mesh_triangles_ + mesh.triangle_count() > caps_.mesh_triangles)
     throw InputError(detail::format("scene {}: {} triangles in its meshes is past the limit of {} "
                                  "(occull::limits::mesh_triangles)",
@@ -101,10 +108,10 @@ bool finite(const glm::mat4& m) {
 
 void Scene::check_object(ObjectId id, const char* what) const {
   if (id >= objects_.size())
-    throw InputError(detail::format("scene {}: {} object {}: no such object (ids 0 to {})", name_, what, id,
+    throw UsageError(detail::format("scene {}: {} object {}: no such object (ids 0 to {})", name_, what, id,
                                  objects_.size() == 0 ? 0 : objects_.size() - 1));
   if (objects_[id].removed)
-    throw InputError(detail::format("scene {}: {} object {}: it was removed", name_, what, id));
+    throw UsageError(detail::format("scene {}: {} object {}: it was removed", name_, what, id));
 }
 
 void Scene::note_moved(ObjectId id) {
@@ -116,9 +123,9 @@ void Scene::note_moved(ObjectId id) {
 ObjectId Scene::add_object(MeshId mesh, MaterialId material, const glm::mat4& transform,
                            OccluderClass occluder) {
   if (mesh >= meshes_.size())
-    throw InputError(detail::format("scene {}: mesh {} does not exist ({} meshes)", name_, mesh, meshes_.size()));
+    throw UsageError(detail::format("scene {}: mesh {} does not exist ({} meshes)", name_, mesh, meshes_.size()));
   if (material >= materials_.size())
-    throw InputError(detail::format("scene {}: material {} does not exist ({} materials)", name_, material,
+    throw UsageError(detail::format("scene {}: material {} does not exist ({} materials)", name_, material,
                                  materials_.size()));
   if (!finite(transform))
     throw InputError(detail::format("scene {}: a new object's transform has an entry that is not finite", name_));
@@ -177,6 +184,7 @@ Object Scene::make_object(MeshId mesh, MaterialId material, const glm::mat4& tra
 
 ObjectId Scene::add_dynamic_object(MeshId mesh, MaterialId material, Motion motion,
                                    OccluderClass occluder, const glm::mat4& local) {
+  check_motion(motion, "add_dynamic_object");
   const glm::mat4 start = motion.transform_at(0.0) * local;
   const ObjectId id = add_object(mesh, material, start, occluder);
   motions_.push_back(std::move(motion));
@@ -186,24 +194,33 @@ ObjectId Scene::add_dynamic_object(MeshId mesh, MaterialId material, Motion moti
   return id;
 }
 
-void Scene::set_motion(std::size_t index, Motion motion) {
-  if (index >= motions_.size())
-    throw InputError(detail::format("scene {}: set_motion of motion {}: the scene has {}", name_, index, motions_.size()));
+void Scene::check_motion(const Motion& motion, const char* what) const {
   const bool finite_points = std::all_of(motion.waypoints.begin(), motion.waypoints.end(), [](const glm::vec3& p) {
     return std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z);
   });
   if (motion.waypoints.size() < 2 || !finite_points || !std::isfinite(motion.speed) || motion.speed <= 0.0f ||
       !std::isfinite(motion.start_offset))
-    throw InputError(detail::format("scene {}: set_motion of motion {}: needs 2 or more finite waypoints and a finite "
-                                 "speed > 0",
-                                 name_, index));
+    throw InputError(detail::format("scene {}: {}: a motion needs 2 or more finite waypoints and a finite speed > 0",
+                                    name_, what));
+}
+
+void Scene::set_motion(std::size_t index, Motion motion) {
+  if (index >= motions_.size())
+    throw UsageError(detail::format("scene {}: set_motion of motion {}: the scene has {}", name_, index, motions_.size()));
+  check_motion(motion, "set_motion");
   motions_[index] = std::move(motion);
 }
 
 void Scene::place_object(ObjectId id, MeshId mesh, MaterialId material, const glm::mat4& transform,
                          OccluderClass occluder) {
-  assert(id < objects_.size() && !objects_[id].dynamic());
-  assert(mesh < meshes_.size() && material < materials_.size());
+  check_object(id, "place_object");
+  if (objects_[id].dynamic())
+    throw UsageError(detail::format("scene {}: place_object of object {}: it is dynamic (it follows its motion)",
+                                    name_, id));
+  if (mesh >= meshes_.size() || material >= materials_.size())
+    throw UsageError(detail::format("scene {}: place_object: mesh {} or material {} does not exist ({} meshes, {} "
+                                    "materials)",
+                                    name_, mesh, material, meshes_.size(), materials_.size()));
   objects_[id] = make_object(mesh, material, transform, occluder);
   note_moved(id);
 }

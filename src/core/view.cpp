@@ -204,7 +204,7 @@ View make_view(const CameraPose& pose, const Lens& lens, int width, int height) 
 
 CameraPath::CameraPath(std::string name, std::string description, std::vector<Key> keys)
     : name_(std::move(name)), description_(std::move(description)), keys_(std::move(keys)) {
-  assert(!keys_.empty());
+  if (keys_.empty()) throw UsageError(detail::format("CameraPath {}: no keys (a path needs one at least)", name_));
 }
 
 double CameraPath::duration() const noexcept {

@@ -1,6 +1,7 @@
 #include "occull/cpu_test_backend.hpp"
 
 #include "occluders.hpp"
+#include "occull/error.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -20,7 +21,7 @@ struct CpuTestBackend::Impl {
   };
 
   Backend& inner_backend() {
-    if (!inner) throw std::logic_error("CpuTestBackend: used before begin_frame()");
+    if (!inner) throw UsageError("CpuTestBackend: used before begin_frame()");
     return *inner;
   }
   QueryId add(Slot s) {
@@ -35,7 +36,7 @@ struct CpuTestBackend::Impl {
     return QueryId(slots.size() - 1);
   }
   Slot& slot(QueryId q) {
-    if (q >= slots.size() || !slots[q].in_use) throw std::logic_error("CpuTestBackend: a query not in flight");
+    if (q >= slots.size() || !slots[q].in_use) throw UsageError("CpuTestBackend: a query not in flight");
     return slots[q];
   }
 

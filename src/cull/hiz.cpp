@@ -63,7 +63,7 @@ class HizCuller final : public Culler, public Resumable {
   static DeviceCulling& device_of(Backend& backend) {
     DeviceCulling* device = backend.device_culling();
     if (!device)
-      throw InputError(
+      throw UsageError(
           "hiz culls on the device and this backend has no device culling (Backend::device_culling() is null): use "
           "occull's GL renderer, or implement DeviceCulling in the engine's backend (occull/device_culling.hpp)");
     return *device;

@@ -1,4 +1,5 @@
 #include "gl.hpp"
+#include "occull/error.hpp"
 
 #include <algorithm>
 #include <stdexcept>
@@ -13,7 +14,7 @@ void check_error(const char* where) {
   if (e == GL_NO_ERROR) return;
   char code[16];
   std::snprintf(code, sizeof code, "0x%04x", e);
-  throw std::runtime_error(std::string("OpenGL error ") + code + " while " + where);
+  throw GlError(std::string("OpenGL error ") + code + " while " + where);
 }
 
 namespace {
@@ -31,7 +32,7 @@ GLuint compile(const char* name, GLenum stage, const std::string& source) {
     std::string log(std::size_t(std::max(len, 1)), '\0');
     glGetShaderInfoLog(shader, len, nullptr, log.data());
     glDeleteShader(shader);
-    throw std::runtime_error(std::string("compiling the ") + name + " " +
+    throw GlError(std::string("compiling the ") + name + " " +
                              (stage == GL_VERTEX_SHADER ? "vertex" : stage == GL_COMPUTE_SHADER ? "compute" : "fragment") +
                              " shader failed: " + log);
   }
@@ -52,7 +53,7 @@ GLuint link(const char* name, std::initializer_list<GLuint> shaders) {
     std::string log(std::size_t(std::max(len, 1)), '\0');
     glGetProgramInfoLog(program, len, nullptr, log.data());
     glDeleteProgram(program);
-    throw std::runtime_error(std::string("linking the ") + name + " program failed: " + log);
+    throw GlError(std::string("linking the ") + name + " program failed: " + log);
   }
   return program;
 }

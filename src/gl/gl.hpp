@@ -14,11 +14,11 @@
 
 namespace occull::gl {
 
-/// Throws std::runtime_error naming `where` if the GL error flag is set.
+/// Throws GlError naming `where` if the GL error flag is set.
 void check_error(const char* where);
 
 /// Compiles and links a program from vertex and fragment source; throws
-/// std::runtime_error with the info log on failure.
+/// GlError with the info log on failure.
 GLuint make_program(const char* name, const std::string& vertex, const std::string& fragment);
 /// Whether the current context lists extension `name`.
 [[nodiscard]] bool has_extension(const char* name);

@@ -4,6 +4,7 @@
 #include "gl.hpp"
 #include "occull/input_limits.hpp"
 #include "scene_mesh.hpp"
+#include "occull/error.hpp"
 
 #include <glm/gtc/type_ptr.hpp>
 
@@ -168,7 +169,7 @@ Painter::Painter(const Scene& scene, int width, int height)
   glNamedFramebufferRenderbuffer(g.fbo, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, g.color_rb);
   glNamedFramebufferRenderbuffer(g.fbo, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, g.depth_rb);
   if (glCheckNamedFramebufferStatus(g.fbo, GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
-    throw std::runtime_error("occull painter: offscreen framebuffer incomplete");
+    throw GlError("occull painter: offscreen framebuffer incomplete");
   check_error("creating the painter");
 }
 

@@ -231,11 +231,11 @@ void Renderer::Impl::prepare_pass(const View& v) {
   clip = view.clip;
   if (device) device->in_frame = false;
   if (scene.meshes().size() > meshes.size())
-    throw std::logic_error(fmt::format("gl::Renderer: the scene has {} meshes, {} more than when the renderer was made; "
+    throw UsageError(fmt::format("gl::Renderer: the scene has {} meshes, {} more than when the renderer was made; "
                                        "meshes added later need a new renderer",
                                        scene.meshes().size(), scene.meshes().size() - meshes.size()));
   if (scene.objects().size() > object_capacity)
-    throw std::logic_error(fmt::format("gl::Renderer: the scene has {} objects, {} more than when the renderer was "
+    throw UsageError(fmt::format("gl::Renderer: the scene has {} objects, {} more than when the renderer was "
                                        "made; objects added later need a new renderer (ids removed and reused are fine)",
                                        scene.objects().size(), scene.objects().size() - object_capacity));
   establish_frame_state();

@@ -286,7 +286,7 @@ void Renderer::Impl::create_device() {
     const auto [w, h] = d.level_size.back();
     d.level_size.push_back({(w + 1) / 2, (h + 1) / 2});
   }
-  if (d.level_size.size() > kMaxLevels) throw std::logic_error("gl::Renderer: depth pyramid deeper than 16 levels");
+  if (d.level_size.size() > kMaxLevels) throw UsageError("gl::Renderer: depth pyramid deeper than 16 levels");
   if (d.level_size.size() > 1) {
     const GLuint w = next_power_of_two(d.level_size[1][0]), h = next_power_of_two(d.level_size[1][1]);
     GLsizei mips = 1;
@@ -350,7 +350,7 @@ void Renderer::Impl::start_device_frame() {
   DeviceState& d = *device;
   if (d.in_frame) return;
   if (scene.objects().size() > object_capacity)
-    throw std::logic_error("gl::Renderer: device culling over more objects than the renderer was made for");
+    throw UsageError("gl::Renderer: device culling over more objects than the renderer was made for");
   d.in_frame = true;
   d.pyramid_built = false;
   d.translucent_pending = false;
@@ -451,7 +451,7 @@ void Renderer::Impl::draw_device_translucent() {
 
 GLuint Renderer::Impl::visibility_buffer(DeviceCulling::Visibility v, const char* call) const {
   if (!device || v >= device->visibility.size() || device->visibility[v] == 0)
-    throw std::logic_error(fmt::format("gl::Renderer::{}: visibility {} was not created by this renderer, or was "
+    throw UsageError(fmt::format("gl::Renderer::{}: visibility {} was not created by this renderer, or was "
                                        "destroyed",
                                        call, v));
   return device->visibility[v];
@@ -552,9 +552,9 @@ void Renderer::draw_newly_visible(Visibility v, int texels) {
   const GLuint buffer = g.visibility_buffer(v, "draw_newly_visible");
   g.start_device_frame();
   if (!g.device->pyramid_built)
-    throw std::logic_error("gl::Renderer::draw_newly_visible: build_depth_pyramid() has not run in this frame");
+    throw UsageError("gl::Renderer::draw_newly_visible: build_depth_pyramid() has not run in this frame");
   if (texels != 2 && texels != 4 && texels != 8 && texels != 16)
-    throw std::logic_error(fmt::format("gl::Renderer::draw_newly_visible: {} texels per axis (2, 4, 8 or 16)", texels));
+    throw UsageError(fmt::format("gl::Renderer::draw_newly_visible: {} texels per axis (2, 4, 8 or 16)", texels));
   glProgramUniform1i(g.device->cull_program, g.device->u_texels, texels);
   g.stamp(4);
   g.dispatch_cull(2, buffer);
@@ -588,7 +588,7 @@ bool Renderer::device_draws_compacted() const { return impl_->device && impl_->d
 std::vector<float> Renderer::read_depth_pyramid(int level) const {
   const Impl& g = *impl_;
   if (!g.device || level < 1 || std::size_t(level) >= g.device->level_size.size())
-    throw std::logic_error(fmt::format("gl::Renderer::read_depth_pyramid: no level {}", level));
+    throw UsageError(fmt::format("gl::Renderer::read_depth_pyramid: no level {}", level));
   const DeviceState& d = *g.device;
   // The level's own texels out of its (larger) mip.
   const auto [w, h] = d.level_size[std::size_t(level)];

@@ -9,6 +9,7 @@
 
 #include "gl.hpp"
 #include "scene_mesh.hpp"
+#include "occull/error.hpp"
 
 #include <fmt/format.h>
 
@@ -125,7 +126,7 @@ struct Renderer::Impl {
   // a query read twice would be freed twice and later handed to two users.
   void check_in_flight(QueryId q, const char* call) const {
     if (q >= query_live.size() || !query_live[q])
-      throw std::logic_error(fmt::format("gl::Renderer::{}: query {} is not in flight ({})", call, q,
+      throw UsageError(fmt::format("gl::Renderer::{}: query {} is not in flight ({})", call, q,
                                          q >= query_live.size() ? "never issued by this renderer"
                                                                 : "already read, or issued by another renderer"));
   }
@@ -211,7 +212,7 @@ struct Renderer::Impl {
   void write_device_records(ObjectId id);
   void device_draw(int region, BackendStats& stats);
   void dispatch_cull(int phase, GLuint visibility);
-  // The buffer of visibility `v`; std::logic_error naming `call` when there is none.
+  // The buffer of visibility `v`; UsageError naming `call` when there is none.
   GLuint visibility_buffer(DeviceCulling::Visibility v, const char* call) const;
   // Appends, ascending, the ids whose flag (one GLuint per object, written by
   // the cull shader) is set in `buffer`'s first `n`; waits for the device.

@@ -8,6 +8,7 @@
 #include "gl.hpp"
 #include "occull/input_limits.hpp"
 #include "scene_mesh.hpp"
+#include "occull/error.hpp"
 
 #include <glm/gtc/type_ptr.hpp>
 
@@ -248,7 +249,7 @@ void Renderer::Impl::create_targets() {
   apply_draw_buffers();
   const GLenum status = glCheckNamedFramebufferStatus(fbo, GL_FRAMEBUFFER);
   if (status != GL_FRAMEBUFFER_COMPLETE)
-    throw std::runtime_error("occull renderer: offscreen framebuffer incomplete (status 0x" +
+    throw GlError("occull renderer: offscreen framebuffer incomplete (status 0x" +
                              std::to_string(status) + ")");
 }
 

@@ -123,7 +123,7 @@ void OsgBackend::render(std::span<const ObjectId> objects) {
   batch_.clear();
   for (ObjectId id : objects) {
     if (id >= instances_.size() || !instances_[id].drawable)
-      throw std::logic_error(fmt::format("OcclusionCullingGroup: the culler drew object {}, which is not there", id));
+      throw UsageError(fmt::format("OcclusionCullingGroup: the culler drew object {}, which is not there", id));
     (instances_[id].translucent ? translucent_ : batch_).push_back(id);
   }
   // A render queue's order: by state set, so state changes only between groups.
@@ -190,7 +190,7 @@ QueryId OsgBackend::issue_query(std::span<const Aabb> boxes) {
 
 void OsgBackend::check(QueryId q) const {
   if (q >= live_.size() || !live_[q])
-    throw std::logic_error(fmt::format("OcclusionCullingGroup: query {} is not in flight", q));
+    throw UsageError(fmt::format("OcclusionCullingGroup: query {} is not in flight", q));
 }
 
 bool OsgBackend::poll(QueryId q) {

@@ -126,9 +126,9 @@ struct RendererOptions {
 /// meshes. Objects may move (update(), set_transform, place_object), be
 /// removed and have their ids reused; objects added past the count the scene
 /// had when the renderer was made, and meshes added after it, are refused
-/// (std::logic_error at the next frame: make a new renderer). Query calls
+/// (UsageError at the next frame: make a new renderer). Query calls
 /// check that the query is in flight (issued by this renderer, not yet read)
-/// and throw std::logic_error otherwise.
+/// and throw UsageError otherwise.
 class Renderer final : public Backend, public DeviceCulling {
  public:
   Renderer(const Scene& scene, const RendererOptions& options);
@@ -187,7 +187,7 @@ class Renderer final : public Backend, public DeviceCulling {
   /// issued it still reads it with result(). Waits for the device if the
   /// result is not there; not counted in stats(). For an instrument after
   /// end_frame() (RecordingBackend::finish_frame: what a conditional draw
-  /// drew). Precondition: `q` is in flight (std::logic_error otherwise).
+  /// drew). Precondition: `q` is in flight (UsageError otherwise).
   [[nodiscard]] std::uint64_t unread_result(QueryId q);
 
   /// One object's visible area in a visible_pixels() pass.
