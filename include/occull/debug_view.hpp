@@ -1,8 +1,9 @@
 // occull — the debug views: what a culler did in one frame, as a picture
-// (occull render --view V, occull view). The seeds' figures are such
-// pictures: NOHC's Figure 1 (queried boxes, successful and wasted), CHC++'s
-// Figures 8.4.2 (state-change batches) and 8.4.6 (multiqueries), the grid
-// thesis' Figure 4.2 (cells green or red).
+// (occull render --view V, occull view). The papers' figures are such
+// pictures: Guthe et al. 2006's Figure 1 (NOHC: queried boxes, successful
+// and wasted), Bittner et al. 2009's Figures 8.4.2 (CHC++: state-change
+// batches) and 8.4.6 (multiqueries), Seletsky 2013's Figure 4.2 (grid cells
+// green or red).
 //
 // A Picture is a description in world space — objects in flat colours,
 // boxes, lines, over the frame's own image or a plain background — made

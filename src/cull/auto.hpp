@@ -72,9 +72,9 @@ class AutoSchedule {
   /// without device culling). Precondition: some other candidate remains.
   void disable(std::size_t c);
   /// Candidate `c`'s first frame may hold one-off costs (hiz: the device's
-  /// buffers made, its programs compiled by the driver: 122 ms against 2 on
-  /// an H200, 315 ms with a cold shader cache on llvmpipe): until it was
-  /// measured once, one frame above 8 x the reference does not end its try.
+  /// buffers made, its programs compiled by the driver; docs/performance.md
+  /// has the figures): until it was measured once, one frame above 8 x the
+  /// reference does not end its try.
   void starts_up(std::size_t c);
   /// An estimate of candidate `c`'s cost of the frame finished() counts
   /// next, in finished()'s unit (0: none). `of_this_view`: made from this

@@ -225,7 +225,7 @@ class QuerySubmitter {
   std::uint32_t pending_ = 0;
 };
 
-/// The eye-inside rule (DESIGN, the engine notes): a box that, grown by the near
+/// The eye-inside rule (from an engine's occlusion notes): a box that, grown by the near
 /// plane radius, contains the eye is visible without a query — its query
 /// could miss the faces around the camera, and an object that close is
 /// visible anyway.
