@@ -15,8 +15,9 @@
 namespace occull::detail {
 
 /// Appends `value` to `out` as fmt's "{}" would: integers in decimal,
-/// floating-point numbers in their shortest form that reads back exactly,
-/// bools as true/false, text as it is. `decimals` >= 0 (a "{:.Nf}" field)
+/// floating-point numbers in their shortest form that reads back exactly
+/// (fixed notation for exponents in [-4, 16)), bools as true/false, text as
+/// it is. `decimals` >= 0 (a "{:.Nf}" field)
 /// writes a floating-point number in fixed notation with that many digits.
 template <typename T>
 void append_formatted(std::string& out, const T& value, int decimals) {
@@ -29,8 +30,35 @@ void append_formatted(std::string& out, const T& value, int decimals) {
     char buffer[64];
     std::to_chars_result r{};
     if constexpr (std::floating_point<V>) {
-      r = decimals >= 0 ? std::to_chars(buffer, buffer + sizeof buffer, value, std::chars_format::fixed, decimals)
-                        : std::to_chars(buffer, buffer + sizeof buffer, value);
+      if (decimals >= 0) {
+        r = std::to_chars(buffer, buffer + sizeof buffer, value, std::chars_format::fixed, decimals);
+      } else {
+        // fmt's "{}": the shortest digits that read back exactly, in fixed
+        // notation for decimal exponents in [-4, 16) (the digits padded with
+        // zeros), else in scientific ("1e-05", "1.5e+16").
+        r = std::to_chars(buffer, buffer + sizeof buffer, value, std::chars_format::scientific);
+        const std::string_view sci(buffer, std::size_t(r.ptr - buffer));
+        const std::size_t e = sci.find('e');
+        int exponent = 0;
+        if (e != std::string_view::npos)
+          std::from_chars(sci.data() + e + (sci[e + 1] == '+' ? 2 : 1), sci.data() + sci.size(), exponent);
+        if (e != std::string_view::npos && exponent >= -4 && exponent < 16) {
+          const bool negative = sci.front() == '-';
+          std::string digits;
+          for (char c : sci.substr(negative ? 1 : 0, e - (negative ? 1 : 0)))
+            if (c != '.') digits += c;
+          std::string fixed = negative ? "-" : "";
+          if (exponent < 0) {
+            fixed += "0." + std::string(std::size_t(-exponent - 1), '0') + digits;
+          } else if (std::size_t(exponent) + 1 >= digits.size()) {
+            fixed += digits + std::string(std::size_t(exponent) + 1 - digits.size(), '0');
+          } else {
+            fixed += digits.substr(0, std::size_t(exponent) + 1) + "." + digits.substr(std::size_t(exponent) + 1);
+          }
+          out += fixed;
+          return;
+        }
+      }
     } else {
       r = std::to_chars(buffer, buffer + sizeof buffer, value);
     }
