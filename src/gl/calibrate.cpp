@@ -139,7 +139,7 @@ CalibrationResult calibrate(const CalibrationOptions& options,
   // Warm up every workload once (shader JIT).
   frame_ms(draw_many_low);
   frame_ms(draw_some_high);
-  for (auto& [cost, ids] : full) frame_ms([&] { r.render(ids); });
+  for (const auto& entry : full) frame_ms([&] { r.render(entry.second); });  // (clang 14 captures no bindings)
   frame_ms([&] { queries(small_box, 10); });
   frame_ms([&] { queries(full_box, 2); });
 
@@ -152,8 +152,9 @@ CalibrationResult calibrate(const CalibrationOptions& options,
                  (double(some_high.size()) * high_triangles));
     samples["T_r^s"].push_back(setup);
     samples["T_r^tri"].push_back(triangle);
-    for (auto& [cost, ids] : full) {
-      const double t = frame_ms([&] { r.render(ids); }) - empty - double(ids.size()) * (setup + 2.0 * triangle);
+    for (const auto& entry : full) {
+      const auto& [cost, ids] = entry;
+      const double t = frame_ms([&] { r.render(entry.second); }) - empty - double(ids.size()) * (setup + 2.0 * triangle);
       samples[fmt::format("T_r^f[{}]", cost)].push_back(std::max(0.0, t / (double(ids.size()) * pixels)));
     }
     const double q_setup = std::max(0.0, (frame_ms([&] { queries(small_box, 1000); }) - empty) / 1000.0);
