@@ -2,6 +2,8 @@
 // it: the per-frame copy, split-screen sums, summaries, JSON, CSV and docs.
 #include "occull/counters.hpp"
 #include "occull/report.hpp"
+#include "occull/scenes.hpp"
+#include "test_util.hpp"
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -9,6 +11,7 @@
 #include <algorithm>
 #include <cstddef>
 #include <fstream>
+#include <set>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -59,6 +62,70 @@ TEST(Counters, EveryFrameStatsMemberHasARow) {
     end = e.offset + e.size;
   }
   EXPECT_LT(sizeof(FrameStats) - end, alignof(FrameStats)) << "a FrameStats member at the end has no row";
+}
+
+// What a culler reports in visit_counters, by name.
+std::vector<std::pair<std::string_view, double>> reported(const Culler& culler) {
+  std::vector<std::pair<std::string_view, double>> out;
+  culler.visit_counters([&](std::string_view name, double value) { out.emplace_back(name, value); });
+  return out;
+}
+
+TEST(Counters, EveryCounterAnAlgorithmReportsHasARowAndReachesTheFrame) {
+  // Every algorithm an engine can make, two frames each (the second with
+  // answers to read), on a box scene or a tiled world; `hiz` needs a device.
+  const Scene boxes = test::box_scene(test::scattered_boxes(60));
+  const Bvh bvh = Bvh::build(boxes);
+  SceneBundle world = make_scene("tiles_city:far=150");
+  const Bvh no_bvh = Bvh::build(std::span<const Aabb>{}, std::span<const std::uint32_t>{});
+  const View box_view = make_view({{0, 2, 40}, 0, 0}, {60.0f, 0.1f, 500.0f}, 64, 64);
+  const View world_view = make_view({{1, 1.7f, -20}, 0, 0}, {60.0f, 0.1f, 150.0f}, 64, 64);
+  world.world->follow(world.scene, world_view.eye);
+  std::set<std::string_view> names;
+  for (const AlgorithmInfo& info : algorithms()) {
+    if (info.harness_only || info.device) continue;
+    const bool tiled = info.scenes == SceneKind::tiled;
+    const SceneIndex index = tiled ? SceneIndex{world.scene, no_bvh, world.world.get()} : SceneIndex{boxes, bvh};
+    auto culler = make_culler(info.name, index, {}, with_profile(test::hardware_profile()));
+    test::ScriptedBackend backend;
+    for (int frame = 0; frame < 2; ++frame) {
+      const FrameResult result = culler->render_frame(tiled ? world_view : box_view, backend);
+      FrameStats stats;
+      ASSERT_NO_THROW(copy_culler_counters(result, *culler, stats)) << info.name;
+      EXPECT_EQ(stats.nodes_visited, result.nodes_visited) << info.name;
+      for (const auto& [name, value] : reported(*culler)) {
+        names.insert(name);
+        const Counter* row = find_counter(name);
+        ASSERT_NE(row, nullptr) << info.name << " reports " << name;
+        EXPECT_EQ(counter_value(*row, stats), value) << info.name << ": " << name;
+      }
+    }
+    culler->release(backend);
+  }
+  // The algorithms' counters, each reported by some algorithm.
+  for (const char* name : {"query_batches", "multiqueries", "failed_multiqueries", "raster_ms", "boxes_tested",
+                           "buffer_texels", "capped", "over_cap", "result_age", "revealed", "auto_choice",
+                           "auto_tries", "auto_switches", "tiles_rendered", "tile_queries", "tile_cache"})
+    EXPECT_EQ(names.count(name), 1u) << name << " is reported by no algorithm";
+}
+
+TEST(Counters, ACounterTheTableDoesNotDeclareIsABug) {
+  struct Undeclared final : Culler {
+    FrameResult cull(const View&, Backend&) override { return {}; }
+    void visit_counters(const CounterVisitor& visit) const override { visit(name, 1.0); }
+    std::string_view name;
+  };
+  Undeclared culler;
+  FrameStats stats;
+  for (std::string_view name : {"overcap", "queries"}) {  // unknown; and one the backend fills
+    culler.name = name;
+    try {
+      copy_culler_counters({}, culler, stats);
+      ADD_FAILURE() << name << " accepted";
+    } catch (const std::logic_error& e) {
+      EXPECT_NE(std::string(e.what()).find(std::string(name)), std::string::npos) << e.what();
+    }
+  }
 }
 
 TEST(Counters, EverySummarisedCounterHasAUniqueKeyThatNamesItsReduction) {

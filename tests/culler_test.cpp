@@ -82,7 +82,7 @@ TEST(Vfc, RendersExactlyTheObjectsNotOutsideTheFrustum) {
   for (float yaw : {0.0f, 1.0f, 2.5f, -2.0f}) {
     const View view = make_view({{3, 1, -4}, yaw, 0.1f}, {60.0f, 0.1f, 80.0f}, 160, 90);
     test::ScriptedBackend backend;
-    const FrameStats stats = culler->render_frame(view, backend);
+    const FrameResult stats = culler->render_frame(view, backend);
     std::vector<ObjectId> expected;
     for (ObjectId id = 0; id < scene.objects().size(); ++id)
       if (view.frustum.classify(scene.object(id).bounds) != Containment::outside) expected.push_back(id);
@@ -92,6 +92,27 @@ TEST(Vfc, RendersExactlyTheObjectsNotOutsideTheFrustum) {
     EXPECT_TRUE(backend.queried.empty());
     EXPECT_GT(stats.nodes_visited, 0u);
     EXPECT_LT(stats.nodes_visited, bvh.size()) << "subtrees outside the frustum are skipped";
+  }
+}
+
+TEST(Culler, RenderFrameReturnsWhatItDrewQueriedAndVisited) {
+  const Scene scene = scattered(2000, 3);
+  const Bvh bvh = Bvh::build(scene);
+  const View view = make_view({{3, 1, -4}, 1.0f, 0.1f}, {60.0f, 0.1f, 80.0f}, 160, 90);
+  for (const char* algorithm : {"vfc", "stopwait", "chcpp", "soc", "grid"}) {
+    auto culler = make_culler(algorithm, {scene, bvh});
+    test::ScriptedBackend backend;
+    backend.visible_samples = [](std::span<const Aabb> boxes) { return std::uint64_t(boxes.size() % 2); };
+    for (int frame = 0; frame < 3; ++frame) {
+      backend.rendered.clear();
+      backend.queried.clear();
+      const FrameResult result = culler->render_frame(view, backend);
+      EXPECT_EQ(result.objects_drawn, backend.rendered.size()) << algorithm << ", frame " << frame;
+      EXPECT_EQ(result.queries, backend.queried.size()) << algorithm << ", frame " << frame;
+      EXPECT_GT(result.nodes_visited, 0u) << algorithm;
+      EXPECT_GE(result.cpu_ms, 0.0) << algorithm;
+    }
+    culler->release(backend);
   }
 }
 
@@ -129,8 +150,7 @@ TEST(MakeCuller, TakesSpecsWithOptionsAndAProfileInMemory) {
   EXPECT_THROW((void)make_culler("chcpp:nope=1", {scene, bvh}), InputError);
   EXPECT_THROW((void)make_culler("nohc", {scene, bvh}), InputError);  // no profile anywhere
   const HardwareProfile profile = test::hardware_profile();
-  CullerContext context;
-  context.nohc_profile = &profile;
+  const CullerContext context = with_profile(profile);
   auto nohc = make_culler("nohc:learn=off", {scene, bvh}, {}, context);
   test::ScriptedBackend backend;
   const View view = make_view({{0, 0, 0}, 0, 0}, {60.0f, 0.1f, 100.0f}, 64, 64);
@@ -184,7 +204,7 @@ TEST(MakeCuller, AsksTheContextForNohcsProfileOnlyWhenACullerNeedsIt) {
   const HardwareProfile profile = test::hardware_profile();
   int asked = 0;
   CullerContext context;
-  context.nohc_profile_source = [&]() -> const HardwareProfile& {
+  context.hardware_profile = [&](const std::string&) -> std::optional<HardwareProfile> {
     ++asked;
     return profile;
   };

@@ -200,7 +200,7 @@ namespace {
 // Draws nothing: every visible object is missed.
 class DrawNothing final : public Culler {
  public:
-  FrameStats cull(const View&, Backend&) override { return {}; }
+  FrameResult cull(const View&, Backend&) override { return {}; }
 };
 
 // The field's glide at 30 fps, 320x180, up to frame 30: there llvmpipe draws

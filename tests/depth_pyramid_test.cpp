@@ -12,6 +12,7 @@
 #include <vector>
 
 using namespace occull;
+using occull::detail::PyramidRules;
 
 namespace {
 

@@ -111,8 +111,7 @@ TEST(EngineDrivenScene, EveryAlgorithmFollowsMovesAdditionsAndRemovals) {
 // with as many behind it.
 TEST(EngineDrivenScene, HierarchicalCullersKeepTheirStateAcrossARebuild) {
   const HardwareProfile profile = test::hardware_profile();
-  CullerContext context;
-  context.nohc_profile = &profile;
+  const CullerContext context = with_profile(profile);
   const View view = test::unsampled(make_view({{0, 0, 0}, 0, 0}, {70.0f, 0.1f, 500.0f}, 64, 64));
   for (const char* name : {"chc", "chcpp", "nohc"}) {
     SCOPED_TRACE(name);

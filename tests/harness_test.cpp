@@ -33,7 +33,7 @@ class DroppingCuller final : public Culler {
  public:
   DroppingCuller(std::unique_ptr<Culler> inner, ObjectId dropped)
       : inner_(std::move(inner)), dropped_(dropped) {}
-  FrameStats cull(const View& view, Backend& backend) override {
+  FrameResult cull(const View& view, Backend& backend) override {
     Filter filter(backend, dropped_);
     return inner_->render_frame(view, filter);
   }

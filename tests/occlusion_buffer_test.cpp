@@ -13,6 +13,7 @@
 #include <random>
 
 using namespace occull;
+using occull::detail::OcclusionRules;
 
 namespace {
 

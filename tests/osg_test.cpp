@@ -96,8 +96,9 @@ TEST(OsgCullingGroup, TheFrameTimeTheApplicationMeasuresReachesAnAdaptiveCuller)
     v.frame(camera_view(), 0.1 * k);
     const osgOccull::CameraFrame* f = s.group->last_frame(&v.camera());
     ASSERT_NE(f, nullptr);
-    choice = f->culler.auto_choice;
-    occull::FrameStats measured;
+    for (const auto& [name, value] : f->counters)
+      if (name == "auto_choice") choice = std::uint32_t(value);
+    occull::FrameMeasure measured;
     measured.frame_ms = choice == 1 ? 100.0 : 1.0;
     s.group->frame_finished(&v.camera(), measured);
   }

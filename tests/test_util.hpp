@@ -12,6 +12,7 @@
 
 #include <filesystem>
 #include <functional>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -53,9 +54,20 @@ class ProfileFile {
 
 /// A culler context that reads the profile files options name
 /// (nohc.profile=FILE), as Session's does.
+/// The counter `name` of `culler`'s last frame (Culler::counter); throws
+/// when the culler keeps none of that name, so a renamed counter fails.
+inline double counter(const Culler& culler, std::string_view name) {
+  const std::optional<double> value = culler.counter(name);
+  if (!value) throw std::logic_error("the culler has no counter " + std::string(name));
+  return *value;
+}
+
 inline CullerContext reading_profiles() {
   CullerContext context;
-  context.read_profile = load_profile;
+  context.hardware_profile = [](const std::string& file) -> std::optional<HardwareProfile> {
+    if (file.empty()) return std::nullopt;  // no device here to calibrate
+    return load_profile(file);
+  };
   return context;
 }
 

@@ -17,6 +17,20 @@ using namespace occull;
 
 namespace {
 
+// A tiled-world culler's own counters of a frame.
+struct TileFrame {
+  std::uint64_t tiles_rendered = 0, tile_queries = 0, tile_postponed = 0, tile_prediction_failures = 0,
+                tiles_instantiated = 0, tiles_evicted = 0, tile_cache = 0;
+};
+
+// Renders a frame with `culler` and reads its counters.
+TileFrame render(Culler& culler, const View& view, Backend& backend) {
+  (void)culler.render_frame(view, backend);
+  const auto read = [&](std::string_view name) { return std::uint64_t(test::counter(culler, name)); };
+  return {read("tiles_rendered"),     read("tile_queries"),  read("tile_postponed"), read("tile_prediction_failures"),
+          read("tiles_instantiated"), read("tiles_evicted"), read("tile_cache")};
+}
+
 // A small window: the far plane sets how many cells the scene holds.
 SceneBundle small_city() { return make_scene("tiles_city:far=150"); }
 
@@ -218,7 +232,7 @@ TEST(TilesCuller, PropagationStopsWhereTheCommonBoxIsOccluded) {
   Options o;
   o.set("tiles.local=none");
   auto culler = make_culler("tiles", t.index(), o);
-  const FrameStats s = culler->render_frame(v, backend);
+  const TileFrame s = render(*culler, v, backend);
   // Only the nearest cell is drawn: every neighbour's tile query came back hidden.
   EXPECT_EQ(s.tiles_rendered, 1u);
   EXPECT_EQ(cells_rendered(*t.bundle.world, backend.rendered).size(), 1u);
@@ -237,7 +251,7 @@ TEST(TilesCuller, AllQueriesVisibleDrawsEveryCellInTheFrustumOnce) {
   Options o;
   o.set("tiles.local=none");
   auto culler = make_culler("tiles", t.index(), o);
-  const FrameStats s = culler->render_frame(v, backend);
+  const TileFrame s = render(*culler, v, backend);
   std::vector<TileCoord> in_frustum;
   detail::cells_in_frustum(*t.bundle.world, v, false, in_frustum);
   EXPECT_EQ(s.tiles_rendered, in_frustum.size());
@@ -256,7 +270,7 @@ TEST(TilesCuller, PendingResultOfATileVisibleLastFrameIsPostponed) {
   Options o;
   o.set("tiles.local=none");
   auto culler = make_culler("tiles", t.index(), o);
-  const FrameStats first = culler->render_frame(v, backend);
+  const TileFrame first = render(*culler, v, backend);
   ASSERT_GT(first.tiles_rendered, 1u);
   EXPECT_EQ(first.tile_postponed, 0u);
   // No result is ready: the tiles seen visible are drawn on their prediction
@@ -264,13 +278,13 @@ TEST(TilesCuller, PendingResultOfATileVisibleLastFrameIsPostponed) {
   // prediction failures (Algorithm 4).
   ready = false;
   backend.read.clear();
-  const FrameStats second = culler->render_frame(v, backend);
+  const TileFrame second = render(*culler, v, backend);
   EXPECT_EQ(second.tiles_rendered, first.tiles_rendered);
   EXPECT_GT(second.tile_postponed, 0u);
   EXPECT_EQ(second.tile_prediction_failures, second.tile_postponed);
   EXPECT_TRUE(backend.read.empty()) << "a postponed query was waited on";
   // Predicted hidden now, so the next frame waits for their results (visible).
-  const FrameStats third = culler->render_frame(v, backend);
+  const TileFrame third = render(*culler, v, backend);
   EXPECT_EQ(third.tiles_rendered, first.tiles_rendered);
   EXPECT_EQ(third.tile_postponed, 0u);
   EXPECT_FALSE(backend.read.empty());
@@ -283,20 +297,20 @@ TEST(TileCache, InstancesUnusedForTheEvictionTimeAreFreed) {
   o.set("pertile.evict=3");
   auto culler = make_culler("pertile", t.index(), o);
   const glm::vec3 eye{1.0f, 1.7f, -20.0f};
-  const FrameStats a = culler->render_frame(t.look(eye, 0.0f), backend);
+  const TileFrame a = render(*culler, t.look(eye, 0.0f), backend);
   EXPECT_GT(a.tiles_instantiated, 0u);
   EXPECT_EQ(a.tile_cache, a.tiles_instantiated);
   // Turn round: the cells ahead go unused and are freed after 3 frames.
   std::uint64_t evicted = 0;
-  FrameStats s;
+  TileFrame s;
   for (int k = 0; k < 5; ++k) {
-    s = culler->render_frame(t.look(eye, glm::pi<float>()), backend);
+    s = render(*culler, t.look(eye, glm::pi<float>()), backend);
     evicted += s.tiles_evicted;
   }
   EXPECT_GT(evicted, 0u);
   EXPECT_EQ(s.tile_cache, s.tiles_rendered) << "only the cells in view are held";
   // A long walk: the cache holds at most the window.
-  for (float z = 0.0f; z > -3000.0f; z -= 14.0f) s = culler->render_frame(t.look({1.0f, 1.7f, z}, 0.0f), backend);
+  for (float z = 0.0f; z > -3000.0f; z -= 14.0f) s = render(*culler, t.look({1.0f, 1.7f, z}, 0.0f), backend);
   const auto side = std::uint64_t(2 * t.bundle.world->radius() + 1);
   EXPECT_LE(s.tile_cache, side * side);
 }
@@ -312,7 +326,7 @@ TEST(TilesCuller, RequeryDrawsVisibleTilesWithoutQueriesBetweenTheirReQueries) {
     if (variant == 1) o.set("tiles.requery=4");
     auto culler = make_culler("tiles", t.index(), o);
     for (int f = 0; f < 8; ++f) {
-      const FrameStats s = culler->render_frame(v, backend);
+      const TileFrame s = render(*culler, v, backend);
       if (f == 0) continue;  // the first frame queries every tile either way
       queries[variant] += s.tile_queries;
       drawn[variant] += s.tiles_rendered;

@@ -54,8 +54,7 @@ TEST(TypedConfig, MakesTheCullerItsSpecMakes) {
   const Bvh bvh = Bvh::build(scene);
   const SceneIndex index{scene, bvh};
   const HardwareProfile profile = test::hardware_profile();
-  CullerContext context;
-  context.nohc_profile = &profile;
+  const CullerContext context = with_profile(profile);
   struct Case {
     std::string spec;
     std::function<std::unique_ptr<Culler>()> typed;

@@ -460,13 +460,12 @@ int run(const Args& args) {
     glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
     glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
     backend.begin_frame(view.view_proj);
-    const occull::BackendStats before = backend.stats();
-    culler->render_frame(view, backend);
+    const occull::FrameResult result = culler->render_frame(view, backend);  // objects drawn, queries, nodes, CPU ms
     const std::span<const occull::ObjectId> drawn_set = culler->drawn_objects();  // for shadows, LOD, streaming
     // [readme end]
     glFinish();
     rebuilds += bvh.generation() != generation ? 1 : 0;
-    queries += backend.stats().queries - before.queries;
+    queries += result.queries;
     drawn += drawn_set.size();
 
     // occull's ground truth: every object with a visible pixel must be drawn.

@@ -102,7 +102,7 @@ struct ChcppConfig {
 struct NohcConfig {
   static constexpr std::string_view algorithm = "nohc";
   QueryOptions common;
-  /// A hardware profile file (read by CullerContext::read_profile); empty:
+  /// A hardware profile file (read by CullerContext::hardware_profile); empty:
   /// the context's profile.
   std::string profile;
   double fragments_per_pixel = 2.0;  ///< overdraw assumed when estimating shaded fragments; in [0, 100]

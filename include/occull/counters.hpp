@@ -1,18 +1,21 @@
 // occull — every per-frame counter of the harness, declared once.
 //
 // One row per FrameStats member says where the counter comes from (the
-// backend's counters, or the culler and the harness), how the views of a
+// backend's counters; the culler's FrameResult or, by the row's name, its
+// algorithm's counters (Culler::visit_counters); or the harness), how the views of a
 // split-screen frame combine it, how a run's frames and the repeats reduce
 // it to the summary figure (the AlgorithmSummary member and JSON key of the
 // same row), how frames.csv prints it, and what it means. The harness's
 // per-frame copy, the split-screen sums, summarize_runs(), the JSON, the CSV
 // columns and the report's legend are all loops over this table: adding a
-// counter is its FrameStats member (and the code that counts it), a row
-// here and, if it has a summary figure, that AlgorithmSummary member.
+// counter is its FrameStats member (and the code that counts it: an
+// algorithm reports it by the row's name), a row here and, if it has a
+// summary figure, that AlgorithmSummary member.
 #pragma once
 
 #include "occull/backend.hpp"
 #include "occull/bench.hpp"
+#include "occull/culler.hpp"
 #include "occull/stats.hpp"
 
 #include <cstdint>
@@ -38,7 +41,7 @@ struct Counter {
   using BackendMember = std::variant<std::monostate, std::uint64_t BackendStats::*, double BackendStats::*>;
   using SummaryMember = std::variant<std::monostate, double AlgorithmSummary::*, std::uint64_t AlgorithmSummary::*>;
 
-  std::string_view name;  ///< the FrameStats member's name; frames.csv's column
+  std::string_view name;  ///< the FrameStats member's name; frames.csv's column; an algorithm's counter of that name
   FrameMember frame;      ///< the FrameStats member
   /// The BackendStats counter whose difference over the frame it is
   /// (std::monostate: the culler or the harness fills it).
@@ -66,6 +69,21 @@ struct Counter {
 /// Copies every backend counter of the frame (`during`: the backend's
 /// stats at the end minus those at the start) into `frame`.
 void copy_backend_counters(const BackendStats& during, FrameStats& frame) noexcept;
+
+/// Copies what a culler says of its frame into `frame`: the result's
+/// nodes_visited and cpu_ms, and each counter `culler` visits
+/// (Culler::visit_counters) into the row of its name. Throws
+/// std::logic_error naming a counter the table has no row for, or one the
+/// backend fills (an algorithm's counter left undeclared: a bug).
+void copy_culler_counters(const FrameResult& result, const Culler& culler, FrameStats& frame);
+
+/// Sets the row `name` of `frame` to `value` (an algorithm's counter, as
+/// copy_culler_counters() does). Throws as it does.
+void set_counter(FrameStats& frame, std::string_view name, double value);
+
+/// What `frame` says of it to a culler that learns from it
+/// (Culler::frame_finished).
+[[nodiscard]] FrameMeasure measure_of(const FrameStats& frame) noexcept;
 
 /// Adds one view's figures to a split-screen frame's `sum` (Counter::views);
 /// after the last view, finish_views() turns the means' sums into means.

@@ -14,7 +14,7 @@
 #include "occull/backend.hpp"
 #include "occull/occlusion_buffer.hpp"
 #include "occull/scene.hpp"
-#include "occull/stats.hpp"
+#include "occull/frame_result.hpp"
 #include "occull/view.hpp"
 
 #include <memory>
@@ -44,9 +44,12 @@ class CpuTestBackend final : public Backend {
   /// (it must outlive the frame), the buffer cleared. Queries still in
   /// flight from an earlier frame stay valid.
   void begin_frame(Backend& inner, const View& view);
-  /// Ends the frame: adds the buffer's counters (raster_ms, test_ms,
-  /// occluder_triangles, boxes_tested, buffer_texels) to `stats`.
-  void end_frame(FrameStats& stats);
+  /// Ends the frame: forgets the view; the frame's counters stay readable.
+  void end_frame();
+  /// The buffer's counters of the current (or last) frame: "raster_ms",
+  /// "test_ms" (CPU time rasterizing occluders and testing boxes, ms),
+  /// "occluder_triangles", "boxes_tested", "buffer_texels".
+  void visit_counters(const CounterVisitor& visit) const;
   /// The buffer of the current (or last) frame; null before the first.
   [[nodiscard]] const OcclusionBuffer* buffer() const noexcept;
   /// Queries of this frame answered on the CPU.

@@ -6,7 +6,7 @@
 #include "occull/configs.hpp"
 #include "occull/cost_model.hpp"
 #include "occull/scene.hpp"
-#include "occull/stats.hpp"
+#include "occull/frame_result.hpp"
 #include "occull/tiles.hpp"
 #include "occull/view.hpp"
 
@@ -22,6 +22,9 @@
 namespace occull {
 
 class OcclusionBuffer;
+namespace detail {
+class DrawRecorder;
+}
 
 
 /// What a culler reads: the scene and its hierarchy, shared read-only by
@@ -84,13 +87,17 @@ struct CullRegion {
 /// of a later call.
 class Culler {
  public:
-  virtual ~Culler() = default;
+  Culler();
+  virtual ~Culler();
+  Culler(const Culler&) = delete;
+  Culler& operator=(const Culler&) = delete;
+
   /// Renders the frame's visible objects through `backend` (the algorithm's
   /// cull()) and records what it drew (drawn_objects()). The caller has
   /// started the frame (cleared the targets) and closes it afterwards.
-  /// Returns the culler's own counters; timings and backend counters are
-  /// left for the caller to fill.
-  FrameStats render_frame(const View& view, Backend& backend);
+  /// Returns what every culler has (objects drawn, queries, nodes visited,
+  /// its CPU time); its algorithm's own counters: visit_counters().
+  FrameResult render_frame(const View& view, Backend& backend);
 
   /// The objects the last render_frame() drew — handed to the backend's
   /// render() or render_conditional() — each once, ascending: the visible
@@ -101,12 +108,24 @@ class Culler {
   /// device (`hiz`): the device holds what it drew (DeviceCulling::read_drawn).
   [[nodiscard]] std::span<const ObjectId> drawn_objects() const;
 
+  /// The algorithm's own counters of the last render_frame(), each by name
+  /// and value: the query cullers' "query_batches" (and CHC++'s
+  /// "multiqueries", "failed_multiqueries"), the CPU occlusion buffer's
+  /// "raster_ms", "boxes_tested", ..., grid's "capped", "over_cap", ...,
+  /// auto's "auto_choice", ... (with its candidate's), the tiled-world
+  /// cullers' "tiles_rendered", .... None before the first frame; none for
+  /// cullers without counters of their own (`none`, `vfc`).
+  virtual void visit_counters(const CounterVisitor& visit) const { (void)visit; }
+  /// The counter `name` of the last render_frame() (visit_counters), or
+  /// nullopt when this culler keeps none of that name.
+  [[nodiscard]] std::optional<double> counter(std::string_view name) const;
+
   /// Optional feedback: the owner calls it once the frame rendered by the
   /// last render_frame() is complete, with what it measured (frame_ms at
   /// least: CPU and GPU time of the whole frame, milliseconds). Adaptive
   /// cullers (`auto`) learn from it; the others ignore it. Without it `auto`
   /// falls back to its own time inside render_frame().
-  virtual void frame_finished(const FrameStats& measured) { (void)measured; }
+  virtual void frame_finished(const FrameMeasure& measured) { (void)measured; }
 
   /// Optional, for the debug views: the regions the last render_frame()
   /// decided on — `grid`: the occupied cells its traversal met; the
@@ -122,8 +141,8 @@ class Culler {
   [[nodiscard]] virtual const OcclusionBuffer* occlusion_buffer() const { return nullptr; }
 
   /// Optional, for the reports: the candidates an adaptive culler (`auto`)
-  /// chooses among, in the order FrameStats::auto_choice numbers them from
-  /// 1 (the spec each was made from). Empty for the other cullers.
+  /// chooses among, in the order its counter "auto_choice" numbers them
+  /// from 1 (the spec each was made from). Empty for the other cullers.
   [[nodiscard]] virtual std::vector<std::string> choices() const { return {}; }
 
   /// Hands back every query the culler holds, through `backend` (which must
@@ -140,32 +159,12 @@ class Culler {
 
  protected:
   /// The algorithm: renders the frame's visible objects through `backend`.
-  virtual FrameStats cull(const View& view, Backend& backend) = 0;
+  /// Returns the nodes it visited (FrameResult::nodes_visited);
+  /// render_frame() fills in the rest.
+  virtual FrameResult cull(const View& view, Backend& backend) = 0;
 
  private:
-  // Forwards every call to the frame's backend and keeps the ids drawn.
-  class DrawRecorder final : public Backend {
-   public:
-    Backend* inner = nullptr;
-    std::vector<ObjectId> drawn;
-    void render(std::span<const ObjectId> objects) override {
-      drawn.insert(drawn.end(), objects.begin(), objects.end());
-      inner->render(objects);
-    }
-    QueryId issue_query(std::span<const Aabb> boxes) override { return inner->issue_query(boxes); }
-    bool result_available(QueryId q) override { return inner->result_available(q); }
-    std::uint64_t result(QueryId q) override { return inner->result(q); }
-    [[nodiscard]] bool conditional_rendering() const override { return inner->conditional_rendering(); }
-    void render_conditional(std::span<const ObjectId> objects, QueryId q, ConditionalWait wait) override {
-      drawn.insert(drawn.end(), objects.begin(), objects.end());
-      inner->render_conditional(objects, q, wait);
-    }
-    void flush() override { inner->flush(); }
-    [[nodiscard]] DeviceCulling* device_culling() override { return inner->device_culling(); }
-    [[nodiscard]] BackendStats stats() const override { return inner->stats(); }
-  };
-  mutable DrawRecorder recorder_;  // drawn_objects() sorts its list once asked
-  mutable bool drawn_sorted_ = true;
+  std::unique_ptr<detail::DrawRecorder> recorder_;  // the frame's backend, keeping the ids drawn
 };
 
 /// The objects of `scene` in `view`'s frustum that are not in `drawn`
@@ -254,28 +253,29 @@ struct AlgorithmSpec {
 void check_options(const Options& options);
 
 /// What an algorithm may need beyond its options, from the program that
-/// makes it. Pointers are borrowed: they must outlive make_culler() only.
+/// makes it.
 ///
-/// nohc's calibrated hardware cost model (occull/cost_model.hpp) comes from,
-/// in this order: the file its option nohc.profile names, read by
-/// `read_profile`; `nohc_profile`; `nohc_profile_source()`. Without any,
-/// making nohc throws InputError, and auto's default candidates leave nohc
-/// out.
+/// nohc's calibrated hardware cost model (occull/cost_model.hpp) comes from
+/// `hardware_profile`: the file its option nohc.profile names, else the
+/// device's. Without one, making nohc throws InputError, and auto's default
+/// candidates leave nohc out.
 struct CullerContext {
-  /// Reads the profile file an option names (nohc.profile=FILE): nullopt
-  /// when the file does not exist; throws InputError when it is corrupt.
-  /// The culling core reads no files: occull::lab's load_profile
-  /// (occull/profile_io.hpp) is one, and Session sets it. Unset, an option
-  /// that names a file makes make_culler() throw InputError.
-  std::function<std::optional<HardwareProfile>(const std::string& file)> read_profile;
-  /// A profile in memory (e.g. one from gl::calibrate).
-  const HardwareProfile* nohc_profile = nullptr;
-  /// Called only when a culler needs a profile and none of the above gives
-  /// one: e.g. loads a cached profile or calibrates one now (Session::make
-  /// does, taking seconds on first use). The reference must outlive
-  /// make_culler().
-  std::function<const HardwareProfile&()> nohc_profile_source;
+  /// Where a culler that models the hardware (`nohc`) gets its profile;
+  /// called only when one is made, with the file its option names
+  /// (nohc.profile=FILE), or "" for the device's own profile. Returns the
+  /// profile, or nullopt where there is none (no such file; no profile of
+  /// the device); throws InputError for a corrupt file. The culling core
+  /// reads no files: occull::lab's load_profile (occull/profile_io.hpp)
+  /// reads one; Session gives its device's profile, calibrating it on first
+  /// use (seconds); with_profile() a profile in memory. Unset: make_culler()
+  /// throws InputError for nohc.
+  std::function<std::optional<HardwareProfile>(const std::string& file)> hardware_profile;
 };
+
+/// A context whose hardware profile is `profile` (e.g. one from
+/// gl::calibrate); it reads no files (a nohc.profile=FILE option makes
+/// make_culler() throw InputError).
+[[nodiscard]] CullerContext with_profile(HardwareProfile profile);
 
 /// Makes a culler from an algorithm spec: a name ("chcpp") or a name with
 /// options ("chcpp:batch=20:tight=off", see parse_algorithm_spec), over

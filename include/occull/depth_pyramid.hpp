@@ -5,7 +5,7 @@
 // A box is found occluded only when every pixel it could cover already holds
 // something nearer than the box's nearest point. The rules that make it so,
 // each with the test in tests/depth_pyramid_test.cpp that fails without it
-// (PyramidRules switches each off):
+// (detail::PyramidRules switches each off):
 //
 //  1. Farthest depth per texel. Each texel of level k+1 holds the farthest
 //     of the (up to) 2×2 texels of level k it covers: max of the depth, or
@@ -55,6 +55,7 @@
 
 namespace occull {
 
+namespace detail {
 /// The rules of the header, each switchable to show what breaks without it
 /// (tests only; the defaults are the conservative test).
 struct PyramidRules {
@@ -67,6 +68,7 @@ struct PyramidRules {
   bool reversed_aware = true;      ///< rule 8; false: reversed-Z depth compared as standard
   bool depth_margin = true;        ///< rule 7; false: occluded when the box's depth is not nearer (ties hidden)
 };
+}  // namespace detail
 
 /// The margin of rule 7: a texel of depth `far` (in the key order, see
 /// DepthPyramid) hides a box only if the box's nearest key exceeds far +
@@ -99,8 +101,11 @@ class DepthPyramid {
   /// reversed-Z, larger is nearer), row-major, bottom row first (level 0).
   /// Throws UsageError unless width, height >= 1 and depth.size() ==
   /// width*height.
+  DepthPyramid(std::span<const float> depth, int width, int height, bool reversed_z)
+      : DepthPyramid(depth, width, height, reversed_z, detail::PyramidRules{}) {}
+  /// Tests only: a pyramid with some rule of the header switched off.
   DepthPyramid(std::span<const float> depth, int width, int height, bool reversed_z,
-               const PyramidRules& rules = {});
+               const detail::PyramidRules& rules);
 
   /// Levels, from 0 (the image) to the one of 1×1 texel.
   [[nodiscard]] int levels() const noexcept { return int(levels_.size()); }
@@ -129,7 +134,7 @@ class DepthPyramid {
   [[nodiscard]] float key(float depth) const noexcept { return reversed_ && rules_.reversed_aware ? -depth : depth; }
   std::vector<Level> levels_;
   bool reversed_ = false;
-  PyramidRules rules_;
+  detail::PyramidRules rules_;
 };
 
 }  // namespace occull

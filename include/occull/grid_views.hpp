@@ -100,13 +100,11 @@ class QueryBudget {
   double floor_;
   Policy policy_;
   std::vector<int> allowance_;
-  static constexpr double kPriorReveals = 0.01;  // per query, as if one query had been seen
   std::vector<double> rate_;
   std::vector<double> revealed_, rechecked_;     // per view, decayed by 3/4 per report
-  static constexpr std::size_t kDemandWindow = 8;  // frames of reports a view's optional demand is the peak of
   std::vector<std::uint64_t> reports_;             // per view
   std::vector<std::uint64_t> forced_;              // per view, its last report
-  std::vector<std::uint64_t> optional_;            // per view, its last kDemandWindow reports
+  std::vector<std::uint64_t> optional_;            // per view, its last 8 reports (the demand window)
 };
 
 /// One grid culler per view over one shared grid and query budget.

@@ -11,7 +11,7 @@
 // centre, so at a resolution below the screen's an object seen through a
 // sub-texel gap is hidden); this one keeps the promise by these rules. Each
 // has the test in tests/occlusion_buffer_test.cpp that fails without it
-// (OcclusionRules switches it off):
+// (detail::OcclusionRules switches it off):
 //
 //  1. Occluders are clipped at the near plane in clip space (the GPU draws
 //     nothing in front of it), and at a guard band far outside the viewport
@@ -91,6 +91,7 @@
 
 namespace occull {
 
+namespace detail {
 /// The rules of the header, each switchable to show what breaks without it
 /// (tests only; the defaults are the conservative buffer).
 struct OcclusionRules {
@@ -104,6 +105,7 @@ struct OcclusionRules {
   bool depth_margin = true;         ///< rule 8; false: hidden when the box's depth is not nearer (ties hidden)
   bool tiles = true;                ///< false: no tile shortcut, every texel read (the answers must not change)
 };
+}  // namespace detail
 
 /// Which code runs the inner loops.
 enum class SimdPath : std::uint8_t {
@@ -156,7 +158,10 @@ class OcclusionBuffer {
   static constexpr int tile_size = 8;  ///< texels per tile side
 
   /// Throws UsageError unless 1 <= width, height <= 8192.
-  OcclusionBuffer(int width, int height, SimdPath simd = SimdPath::best, const OcclusionRules& rules = {});
+  OcclusionBuffer(int width, int height, SimdPath simd = SimdPath::best)
+      : OcclusionBuffer(width, height, simd, detail::OcclusionRules{}) {}
+  /// Tests only: a buffer with some rule of the header switched off.
+  OcclusionBuffer(int width, int height, SimdPath simd, const detail::OcclusionRules& rules);
 
   [[nodiscard]] int width() const noexcept { return width_; }
   [[nodiscard]] int height() const noexcept { return height_; }
@@ -220,7 +225,7 @@ class OcclusionBuffer {
   int width_, height_;
   int tiles_x_, tiles_y_;
   SimdPath simd_;
-  OcclusionRules rules_;
+  detail::OcclusionRules rules_;
   ClipSpace clip_;
   std::vector<float> keys_;
   std::vector<float> tile_far_;

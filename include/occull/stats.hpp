@@ -1,13 +1,15 @@
-// occull — per-frame statistics.
+// occull — the lab's record of one frame (not the core's: a culler returns
+// occull/frame_result.hpp's FrameResult and reports its own counters).
 #pragma once
 
 #include <cstdint>
 
 namespace occull {
 
-/// What one frame of one culler cost. A culler fills the counters it owns
-/// (nodes_visited, multiqueries, ...); the harness adds the backend's
-/// counters and the timings. Times in milliseconds. Every member has its
+/// What one frame of one culler cost, as the lab records it: the culler's
+/// FrameResult and its algorithm's counters (Culler::visit_counters, each
+/// into the member of its name: copy_culler_counters), the backend's
+/// counters, the timings and the verification. Times in milliseconds. Every member has its
 /// row in occull/counters.hpp (how it is summarised, its JSON key and CSV
 /// column); a member without one fails Counters.EveryFrameStatsMemberHasARow.
 struct FrameStats {

@@ -54,7 +54,7 @@ int pyramid_level_for(int extent) noexcept {
 }
 
 DepthPyramid::DepthPyramid(std::span<const float> depth, int width, int height, bool reversed_z,
-                           const PyramidRules& rules)
+                           const detail::PyramidRules& rules)
     : reversed_(reversed_z), rules_(rules) {
   if (width < 1 || height < 1 || depth.size() != std::size_t(width) * std::size_t(height))
     throw UsageError(detail::format("DepthPyramid: {} depth values for {}x{} texels", depth.size(), width, height));

@@ -191,7 +191,7 @@ OccluderMesh make_occluder_mesh(std::span<const glm::vec3> positions, std::span<
   return out;
 }
 
-OcclusionBuffer::OcclusionBuffer(int width, int height, SimdPath simd, const OcclusionRules& rules)
+OcclusionBuffer::OcclusionBuffer(int width, int height, SimdPath simd, const detail::OcclusionRules& rules)
     : width_(width),
       height_(height),
       tiles_x_((width + tile_size - 1) / tile_size),

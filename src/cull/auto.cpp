@@ -420,9 +420,9 @@ class AutoCuller final : public Culler {
       : scene_(index.scene), content_of_(index), candidates_(std::move(candidates)),
         schedule_(config, candidates_.size()) {}
 
-  FrameStats cull(const View& view, Backend& backend) override {
+  FrameResult cull(const View& view, Backend& backend) override {
     if (!started_) start(backend);
-    if (awaiting_feedback_) finished(FrameStats{});  // the owner did not call frame_finished
+    if (awaiting_feedback_) finished(FrameMeasure{});  // the owner did not call frame_finished
     content_ = content_of_(view, false);
     const bool cut = camera_cut(view);
     cuts_in_a_row_ = cut ? cuts_in_a_row_ + 1 : 0;
@@ -441,18 +441,30 @@ class AutoCuller final : public Culler {
     // The prediction: the candidate's last measured cost per unit of content (0 before its first).
     const double predicted = after_cut_ > 0 ? 0.0 : schedule_.cost(run) * content_;
     const auto t0 = std::chrono::steady_clock::now();
-    FrameStats s = candidates_[run].culler->render_frame(view, backend);
+    const FrameResult result = candidates_[run].culler->render_frame(view, backend);
     own_ms_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     last_ = run;
     awaiting_feedback_ = true;
-    s.auto_choice = std::uint32_t(run + 1);
-    s.auto_tries = tried ? 1 : 0;
-    s.auto_switches = switched ? 1 : 0;
-    s.auto_predicted_ms = predicted;
-    return s;
+    tried_ = tried;
+    switched_ = switched;
+    predicted_ms_ = predicted;
+    return result;
   }
 
-  void frame_finished(const FrameStats& measured) override {
+  // The candidate's counters, and auto's: which candidate ran (1 + its
+  // index in choices()), whether the frame started a try or a switch, and
+  // the cost it predicted for it before running it (0: none yet, or a frame
+  // after a camera cut), ms.
+  void visit_counters(const CounterVisitor& visit) const override {
+    if (last_ >= candidates_.size()) return;  // no frame rendered yet
+    candidates_[last_].culler->visit_counters(visit);
+    visit("auto_choice", double(last_ + 1));
+    visit("auto_tries", tried_ ? 1.0 : 0.0);
+    visit("auto_switches", switched_ ? 1.0 : 0.0);
+    visit("auto_predicted_ms", predicted_ms_);
+  }
+
+  void frame_finished(const FrameMeasure& measured) override {
     if (last_ >= candidates_.size()) return;  // no frame rendered yet
     candidates_[last_].culler->frame_finished(measured);
     if (awaiting_feedback_) finished(measured);
@@ -507,7 +519,7 @@ class AutoCuller final : public Culler {
   // vfc would lose by far (a dense city), and switches to vfc where even so
   // it is cheaper than the current by the margin (open ground, where the
   // culler hides little and its own CPU is what it adds).
-  void finished(const FrameStats& measured) {
+  void finished(const FrameMeasure& measured) {
     awaiting_feedback_ = false;
     const double drawn = double(measured.triangles) + kTrianglesPerDraw * double(measured.draw_calls);
     // (Not from hiz's frames: what the device drew is read back after the frame, if at all.)
@@ -572,6 +584,8 @@ class AutoCuller final : public Culler {
   std::size_t last_ = std::size_t(-1);  // the candidate run in the last frame
   std::uint64_t frame_ = 0;             // frames run, counting from 1
   double own_ms_ = 0.0;
+  bool tried_ = false, switched_ = false;  // the last frame started a try, a switch (counters)
+  double predicted_ms_ = 0.0;  // the cost predicted for the last frame, ms (counters)
   std::array<double, kPriceFrames> prices_{};  // the last frames' cost per unit drawn (vfc's estimate)
   std::size_t priced_ = 0;
   bool awaiting_feedback_ = false;

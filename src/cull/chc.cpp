@@ -30,7 +30,12 @@ class ChcCuller final : public CpuTestedCuller {
       : CpuTestedCuller(index, c.common), index_(index), common_(c.common), skip_(c.skip), state_(index.bvh.size()), submitter_(c.flush_every) {}
 
  private:
-  FrameStats cull_frame(const View& view, Backend& backend) override {
+  void visit_counters(const CounterVisitor& visit) const override {
+    f_.counters.visit(visit);
+    CpuTestedCuller::visit_counters(visit);
+  }
+
+  FrameResult cull_frame(const View& view, Backend& backend) override {
     ++frame_;
     seen_.begin(index_.scene);
     if (states_restart(seen_, index_.bvh, frame_ - 1)) carry_over(state_, index_.bvh, seen_, frame_ - 1);
@@ -49,7 +54,7 @@ class ChcCuller final : public CpuTestedCuller {
       }
       if (queue_.empty()) continue;
       const NodeId n = queue_.pop();
-      ++f_.stats.nodes_visited;
+      ++f_.nodes_visited;
       NodeState& s = state_[n];
       const bool previously_visible = was_visible(s, frame_);
       s.visible = false;  // invisible until shown otherwise
@@ -93,7 +98,7 @@ class ChcCuller final : public CpuTestedCuller {
     append_query_boxes(index_, n, {}, boxes_);
     const QueryId q = f_.backend->issue_query(boxes_);
     queries_.push_back({q, n, previously_visible, submitter_.issued(*f_.backend)});
-    ++f_.stats.query_batches;
+    ++f_.counters.query_batches;
   }
 
   void handle_returned_query(const Pending& p, std::uint64_t samples) {

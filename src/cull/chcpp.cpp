@@ -115,7 +115,12 @@ class ChcppCuller final : public CpuTestedCuller {
         state_(index.bvh.size()), random_(config.seed), gate_(reset_nodes(), config.enter_p_min) {}
 
  private:
-  FrameStats cull_frame(const View& view, Backend& backend) override {
+  void visit_counters(const CounterVisitor& visit) const override {
+    f_.counters.visit(visit);
+    CpuTestedCuller::visit_counters(visit);
+  }
+
+  FrameResult cull_frame(const View& view, Backend& backend) override {
     ++frame_;
     seen_.begin(index_.scene);
     if (states_restart(seen_, index_.bvh, frame_ - 1)) {
@@ -148,7 +153,7 @@ class ChcppCuller final : public CpuTestedCuller {
     // One last batch for the visible leaves not queried yet, then their results.
     if (!v_queue_.empty()) {
       flush_render_queue();
-      ++f_.stats.query_batches;
+      ++f_.counters.query_batches;
       while (!v_queue_.empty()) {
         const NodeId n = v_queue_.front();
         v_queue_.pop_front();
@@ -207,7 +212,7 @@ class ChcppCuller final : public CpuTestedCuller {
   }
 
   void process_node(NodeId n) {
-    ++f_.stats.nodes_visited;
+    ++f_.nodes_visited;
     NodeState& s = state_[n];
     const bool previously_visible = was_visible(s, frame_);
     const bool previously_occluded =
@@ -246,7 +251,7 @@ class ChcppCuller final : public CpuTestedCuller {
           v_queue_.push_back(n);
         } else {
           flush_render_queue();  // CHC order: query the leaf, then render it
-          ++f_.stats.query_batches;
+          ++f_.counters.query_batches;
           issue_one(n, true);
         }
       } else {
@@ -284,7 +289,7 @@ class ChcppCuller final : public CpuTestedCuller {
     boxes_.clear();
     for (std::uint32_t i = first; i < first + count; ++i)
       append_query_boxes(index_, query_nodes_[i], config_.shape, boxes_);
-    if (count > 1) ++f_.stats.multiqueries;
+    if (count > 1) ++f_.counters.multiqueries;
     query_queue_.push_back({f_.backend->issue_query(boxes_), first, count, previously_visible});
   }
 
@@ -296,7 +301,7 @@ class ChcppCuller final : public CpuTestedCuller {
 
   void issue_v_query() {
     flush_render_queue();
-    ++f_.stats.query_batches;
+    ++f_.counters.query_batches;
     const NodeId n = v_queue_.front();
     v_queue_.pop_front();
     issue_one(n, true);
@@ -307,7 +312,7 @@ class ChcppCuller final : public CpuTestedCuller {
   void issue_multiqueries() {
     if (i_queue_.empty()) return;
     flush_render_queue();
-    ++f_.stats.query_batches;
+    ++f_.counters.query_batches;
     // Most likely to stay invisible first.
     order_.clear();
     for (const Invisible& e : i_queue_) {
@@ -357,7 +362,7 @@ class ChcppCuller final : public CpuTestedCuller {
       return;
     }
     if (visible && nodes.size() > 1) {  // failed multiquery: query each node alone
-      ++f_.stats.failed_multiqueries;
+      ++f_.counters.failed_multiqueries;
       for (NodeId n : nodes) i_queue_.push_back({n, true});
       return;
     }

@@ -46,7 +46,7 @@ struct CpuTestBackend::Impl {
   std::optional<OcclusionBuffer> buffer;
   const View* view = nullptr;
   Backend* inner = nullptr;
-  FrameStats counters;
+  detail::BufferCounters counters;
   std::uint64_t answered = 0;
   std::vector<Slot> slots;
   std::vector<QueryId> free;
@@ -71,15 +71,9 @@ void CpuTestBackend::begin_frame(Backend& inner, const View& view) {
   m.answered = 0;
 }
 
-void CpuTestBackend::end_frame(FrameStats& stats) {
-  const FrameStats& c = impl_->counters;
-  stats.raster_ms += c.raster_ms;
-  stats.test_ms += c.test_ms;
-  stats.occluder_triangles += c.occluder_triangles;
-  stats.boxes_tested += c.boxes_tested;
-  stats.buffer_texels += c.buffer_texels;
-  impl_->view = nullptr;
-}
+void CpuTestBackend::end_frame() { impl_->view = nullptr; }
+
+void CpuTestBackend::visit_counters(const CounterVisitor& visit) const { impl_->counters.visit(visit); }
 
 const OcclusionBuffer* CpuTestBackend::buffer() const noexcept {
   return impl_->buffer ? &*impl_->buffer : nullptr;

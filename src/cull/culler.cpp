@@ -10,6 +10,7 @@
 #include <cassert>
 #include <cctype>
 #include <charconv>
+#include <chrono>
 #include <cmath>
 #include <typeinfo>
 
@@ -190,23 +191,94 @@ bool is_conservative(const AlgorithmSpec& spec) {
   return entry->info.conservative && !(entry->approximate && entry->approximate(spec.options));
 }
 
-FrameStats Culler::render_frame(const View& view, Backend& backend) {
-  recorder_.inner = &backend;
-  recorder_.drawn.clear();
-  drawn_sorted_ = false;
-  FrameStats stats = cull(view, recorder_);
-  recorder_.inner = nullptr;  // no backend kept between frames
-  return stats;
+namespace detail {
+
+// Forwards every call to the frame's backend and keeps the ids drawn and
+// the queries issued.
+class DrawRecorder final : public Backend {
+ public:
+  Backend* inner = nullptr;
+  std::vector<ObjectId> drawn;
+  bool sorted = true;  // drawn_objects() sorts the list once asked
+  std::uint64_t objects = 0;
+  std::uint64_t queries = 0;
+
+  void render(std::span<const ObjectId> ids) override {
+    keep(ids);
+    inner->render(ids);
+  }
+  QueryId issue_query(std::span<const Aabb> boxes) override {
+    ++queries;
+    return inner->issue_query(boxes);
+  }
+  bool result_available(QueryId q) override { return inner->result_available(q); }
+  std::uint64_t result(QueryId q) override { return inner->result(q); }
+  [[nodiscard]] bool conditional_rendering() const override { return inner->conditional_rendering(); }
+  void render_conditional(std::span<const ObjectId> ids, QueryId q, ConditionalWait wait) override {
+    keep(ids);
+    inner->render_conditional(ids, q, wait);
+  }
+  void flush() override { inner->flush(); }
+  [[nodiscard]] DeviceCulling* device_culling() override { return inner->device_culling(); }
+  [[nodiscard]] BackendStats stats() const override { return inner->stats(); }
+
+ private:
+  void keep(std::span<const ObjectId> ids) {
+    drawn.insert(drawn.end(), ids.begin(), ids.end());
+    objects += ids.size();
+  }
+};
+
+}  // namespace detail
+
+Culler::Culler() : recorder_(std::make_unique<detail::DrawRecorder>()) {}
+Culler::~Culler() = default;
+
+FrameResult Culler::render_frame(const View& view, Backend& backend) {
+  detail::DrawRecorder& r = *recorder_;
+  r.inner = &backend;
+  r.drawn.clear();
+  r.sorted = false;
+  r.objects = r.queries = 0;
+  const double backend_ms = backend.stats().backend_ms;
+  const auto start = std::chrono::steady_clock::now();
+  FrameResult result = cull(view, r);
+  const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  result.cpu_ms = std::max(0.0, ms - (backend.stats().backend_ms - backend_ms));
+  result.objects_drawn = r.objects;
+  result.queries = r.queries;
+  r.inner = nullptr;  // no backend kept between frames
+  return result;
 }
 
 std::span<const ObjectId> Culler::drawn_objects() const {
-  if (!drawn_sorted_) {
-    std::vector<ObjectId>& d = recorder_.drawn;
-    std::sort(d.begin(), d.end());
-    d.erase(std::unique(d.begin(), d.end()), d.end());
-    drawn_sorted_ = true;
+  detail::DrawRecorder& r = *recorder_;
+  if (!r.sorted) {
+    std::sort(r.drawn.begin(), r.drawn.end());
+    r.drawn.erase(std::unique(r.drawn.begin(), r.drawn.end()), r.drawn.end());
+    r.sorted = true;
   }
-  return recorder_.drawn;
+  return r.drawn;
+}
+
+CullerContext with_profile(HardwareProfile profile) {
+  CullerContext context;
+  context.hardware_profile = [profile = std::move(profile)](const std::string& file) -> std::optional<HardwareProfile> {
+    if (!file.empty())
+      throw InputError(detail::format("nohc.profile={}: this program reads no profile files (its culler context "
+                                      "holds one profile in memory)",
+                                      file));
+    return profile;
+  };
+  return context;
+}
+
+std::optional<double> Culler::counter(std::string_view name) const {
+  std::optional<double> found;
+  visit_counters([&](std::string_view n, double value) {
+    if (n == name) found = value;
+  });
+  return found;
 }
 
 std::vector<ObjectId> objects_not_drawn(const Scene& scene, const View& view, std::span<const ObjectId> drawn) {

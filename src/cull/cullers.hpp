@@ -43,8 +43,7 @@ class Resumable {
 };
 
 /// nohc's hardware profile for a culler: the file `file` names (the option
-/// nohc.profile, read by `context.read_profile`), else `context.nohc_profile`, else
-/// `context.nohc_profile_source()`. Throws
+/// nohc.profile), else the device's, both from `context.hardware_profile`. Throws
 /// InputError when there is none, the file does not exist, or nothing
 /// reads files.
 HardwareProfile nohc_profile(const CullerContext& context, const std::string& file);

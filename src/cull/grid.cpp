@@ -71,8 +71,17 @@ class GridCuller final : public Culler {
         drawn_(index.scene.objects().size(), ~std::uint64_t(0)),
         seen_placement_(index.scene.placement_revision()), rng_(config.seed) {}
 
-  FrameStats cull(const View& view, Backend& backend) override {
-    FrameStats stats;
+  void visit_counters(const CounterVisitor& visit) const override {
+    visit("query_batches", double(counters_.query_batches));
+    visit("capped", double(counters_.capped));
+    visit("over_cap", double(counters_.over_cap));
+    visit("result_age", counters_.result_age);
+    visit("revealed", double(counters_.revealed));
+  }
+
+  FrameResult cull(const View& view, Backend& backend) override {
+    FrameResult result;
+    Counters& stats = counters_ = {};
     for (ObjectId id : scene_.dynamic_objects()) grid_->update(id, scene_.object(id).bounds);
     // What the engine moved, added or removed (the grid may be shared: updates are idempotent).
     seen_placement_ = scene_.for_each_changed_since(
@@ -91,7 +100,7 @@ class GridCuller final : public Culler {
     regions_.clear();
     for (const CellRun& run : traversal_.traverse(grid_->geometry(), view, config_.traversal)) {
       for (int i = 0; i < run.count; ++i) {
-        ++stats.nodes_visited;
+        ++result.nodes_visited;
         const std::uint32_t c = grid_->find(run.start + run.step * i);
         if (c == UniformGrid::kNoCell || grid_->objects(c).empty()) continue;
         Cell& cell = cells_[c];
@@ -162,10 +171,21 @@ class GridCuller final : public Culler {
     backend.flush();  // the queries run while the colour pass is drawn
     if (!colour_.empty()) backend.render(colour_);
     if (config_.latency == 0) reveal(view, backend, stats);
-    return stats;
+    return result;
   }
 
  private:
+  // The frame's counters beyond FrameResult: the query cap's (whether the
+  // frame reached it, how many cells due a query it deferred, how old the
+  // answers used were) and latency=0's reveals.
+  struct Counters {
+    std::uint64_t query_batches = 0;  // queries issued (one cell each)
+    std::uint64_t capped = 0;         // 1 when the frame reached the query cap
+    std::uint64_t over_cap = 0;       // queries due but deferred by the cap
+    double result_age = 0.0;          // mean frames since the query behind each answer used was issued
+    std::uint64_t revealed = 0;       // hidden cells found visible by this frame's query and drawn in it
+  };
+
   struct Cell {
     std::uint64_t until = 0;       // the last frame the stored answer holds (expiry)
     std::uint64_t seen = ~std::uint64_t(0);  // last frame the traversal met the cell
@@ -188,7 +208,7 @@ class GridCuller final : public Culler {
   // were flushed before the colour pass, so on a device that works while
   // the CPU submits, most answers are in by now. The answers are kept for
   // gather(), which treats them as every other.
-  void reveal(const View& view, Backend& backend, FrameStats& stats) {
+  void reveal(const View& view, Backend& backend, Counters& stats) {
     colour_.clear();
     for (Pending& p : pending_) {
       if (p.drawn) continue;
@@ -274,6 +294,7 @@ class GridCuller final : public Culler {
   std::vector<Pending> pending_;        // this frame's queries, read next frame
   std::vector<ObjectId> prepass_, inside_, colour_;
   std::vector<CullRegion> regions_;     // this frame's cells (Culler::regions)
+  Counters counters_;                   // of the last frame
   std::uint64_t frame_ = 0;
   int capped_frames_ = 0;               // consecutive frames that hit the cap
   std::mt19937 rng_;
@@ -349,6 +370,11 @@ Registration grid_registration() {
 }  // namespace occull::detail
 
 namespace occull {
+
+namespace {
+constexpr double kPriorReveals = 0.01;           // per query, as if one query had been seen
+constexpr std::size_t kDemandWindow = 8;         // frames of reports a view's optional demand is the peak of
+}  // namespace
 
 QueryBudget::QueryBudget(int total, int views, double floor, Policy policy)
     : total_(total), floor_(floor), policy_(policy), allowance_(std::size_t(views)), rate_(std::size_t(views), kPriorReveals),

@@ -31,7 +31,7 @@ class HizCuller final : public Culler, public Resumable {
  public:
   explicit HizCuller(const HizConfig& config) : config_(config) {}
 
-  FrameStats cull(const View&, Backend& backend) override {
+  FrameResult cull(const View&, Backend& backend) override {
     DeviceCulling& device = device_of(backend);
     if (!visibility_) visibility_ = device.create_visibility();
     if (resume_) device.set_visible(*visibility_, handed_over_);

@@ -90,7 +90,12 @@ class NohcCuller final : public CpuTestedCuller {
   }
 
  private:
-  FrameStats cull_frame(const View& view, Backend& backend) override {
+  void visit_counters(const CounterVisitor& visit) const override {
+    f_.counters.visit(visit);
+    CpuTestedCuller::visit_counters(visit);
+  }
+
+  FrameResult cull_frame(const View& view, Backend& backend) override {
     ++frame_;
     // A rebuilt hierarchy starts from what was drawn last frame (carry_over;
     // conservative whatever it says: only queries cull); a changed set of
@@ -231,7 +236,7 @@ class NohcCuller final : public CpuTestedCuller {
   }
 
   void visit(NodeId n) {
-    ++f_.stats.nodes_visited;
+    ++f_.nodes_visited;
     NodeInfo& info = nodes_[n];
     const PreviousState previous = previous_state(n);
     info.visible = false;
@@ -264,7 +269,7 @@ class NohcCuller final : public CpuTestedCuller {
       const bool wait = previous == PreviousState::occluded;
       const QueryId q = f_.backend->issue_query(boxes_);
       query_queue_.push_back({q, n, wait, previous, model_p_occl, submitter_.issued(*f_.backend)});
-      ++f_.stats.query_batches;
+      ++f_.counters.query_batches;
       info.frames_since_query = 0;
       if (!wait) process(n);
     } else {
@@ -361,19 +366,15 @@ class NohcCuller final : public CpuTestedCuller {
 }  // namespace
 
 HardwareProfile nohc_profile(const CullerContext& context, const std::string& file) {
-  if (!file.empty()) {
-    if (!context.read_profile)
-      throw InputError(detail::format("nohc.profile={}: this program reads no profile files (CullerContext::read_profile "
-                                      "is unset; occull::lab's load_profile reads them)",
-                                      file));
-    std::optional<HardwareProfile> profile = context.read_profile(file);
-    if (!profile) throw InputError(detail::format("nohc.profile: '{}' does not exist", file));
-    return std::move(*profile);
-  }
-  if (context.nohc_profile) return *context.nohc_profile;
-  if (context.nohc_profile_source) return context.nohc_profile_source();
+  if (!file.empty() && !context.hardware_profile)
+    throw InputError(detail::format("nohc.profile={}: this program reads no profile files (CullerContext::hardware_profile "
+                                    "is unset; occull::lab's load_profile reads them)",
+                                    file));
+  std::optional<HardwareProfile> profile = context.hardware_profile ? context.hardware_profile(file) : std::nullopt;
+  if (profile) return std::move(*profile);
+  if (!file.empty()) throw InputError(detail::format("nohc.profile: '{}' does not exist", file));
   throw InputError("nohc needs a hardware profile: run `occull calibrate` (occull bench does it for you), or pass "
-                   "--opt nohc.profile=FILE (CullerContext::nohc_profile in a program)");
+                   "--opt nohc.profile=FILE (CullerContext::hardware_profile in a program)");
 }
 
 Registration nohc_registration() {

@@ -8,7 +8,7 @@ class NoneCuller final : public Culler {
  public:
   explicit NoneCuller(const SceneIndex& index) : scene_(index.scene) {}
 
-  FrameStats cull(const View&, Backend& backend) override {
+  FrameResult cull(const View&, Backend& backend) override {
     if (!listed_ || layout_ != scene_.layout_revision()) {  // objects added or removed
       all_.clear();
       for (ObjectId id = 0; id < scene_.objects().size(); ++id)

@@ -16,7 +16,7 @@ void Occluders::begin_frame(const View& view, const OcclusionBuffer& buffer) {
   sometimes_left_ = std::uint64_t(choice_.budget);
 }
 
-void Occluders::rasterize_if_occluder(OcclusionBuffer& buffer, ObjectId id, const View& view, FrameStats& stats) {
+void Occluders::rasterize_if_occluder(OcclusionBuffer& buffer, ObjectId id, const View& view, BufferCounters& counters) {
   const Object& o = scene_.object(id);
   if (o.removed || o.occluder == OccluderClass::never || scene_.material(o.material).translucent) return;
   const Mesh& mesh = scene_.mesh(o.mesh);
@@ -29,8 +29,8 @@ void Occluders::rasterize_if_occluder(OcclusionBuffer& buffer, ObjectId id, cons
   if (2.0 * radius * texel_scale_ / distance < choice_.min_texels) return;
   const auto start = std::chrono::steady_clock::now();
   const std::uint32_t drawn = buffer.rasterize(mesh.positions, occluder_of(o.mesh), view, o.transform, o.bounds);
-  stats.raster_ms += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-  stats.occluder_triangles += drawn;
+  counters.raster_ms += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  counters.occluder_triangles += drawn;
   if (o.occluder == OccluderClass::sometimes) sometimes_left_ -= o.triangles;
 }
 

@@ -5,12 +5,30 @@
 #include "occull/configs.hpp"
 #include "occull/occlusion_buffer.hpp"
 #include "occull/scene.hpp"
-#include "occull/stats.hpp"
+#include "occull/frame_result.hpp"
 
 #include <optional>
 #include <vector>
 
 namespace occull::detail {
+
+/// The counters of a frame culled with a CPU occlusion buffer (`soc`, and
+/// the query cullers' first test).
+struct BufferCounters {
+  double raster_ms = 0.0;                ///< CPU time rasterizing occluders
+  double test_ms = 0.0;                  ///< CPU time testing boxes
+  std::uint64_t occluder_triangles = 0;  ///< triangles rasterized (after clipping, front faces)
+  std::uint64_t boxes_tested = 0;        ///< node and object boxes tested
+  std::uint64_t buffer_texels = 0;       ///< the buffer's width × height
+
+  void visit(const CounterVisitor& visit) const {
+    visit("raster_ms", raster_ms);
+    visit("test_ms", test_ms);
+    visit("occluder_triangles", double(occluder_triangles));
+    visit("boxes_tested", double(boxes_tested));
+    visit("buffer_texels", double(buffer_texels));
+  }
+};
 
 /// Occluders: opaque objects of class `always`, and of class `sometimes`
 /// while the frame's budget of their triangles lasts, whose mesh has
@@ -23,9 +41,9 @@ class Occluders {
   /// Starts a frame on `buffer` (already cleared) seen through `view`.
   void begin_frame(const View& view, const OcclusionBuffer& buffer);
   /// Rasterizes object `id` if it is an occluder; adds the time and
-  /// polygons to stats.raster_ms and stats.occluder_triangles. The caller
-  /// guarantees the object is drawn in this frame.
-  void rasterize_if_occluder(OcclusionBuffer& buffer, ObjectId id, const View& view, FrameStats& stats);
+  /// polygons to counters.raster_ms and counters.occluder_triangles. The
+  /// caller guarantees the object is drawn in this frame.
+  void rasterize_if_occluder(OcclusionBuffer& buffer, ObjectId id, const View& view, BufferCounters& counters);
 
  private:
   const OccluderMesh& occluder_of(MeshId mesh);

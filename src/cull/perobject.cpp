@@ -32,8 +32,11 @@ class PerObjectCuller final : public Culler {
     for (State& s : state_) s.frames_without_test = interval_;
   }
 
-  FrameStats cull(const View& view, Backend& backend) override {
-    FrameStats stats;
+  void visit_counters(const CounterVisitor& visit) const override { counters_.visit(visit); }
+
+  FrameResult cull(const View& view, Backend& backend) override {
+    FrameResult result;
+    counters_ = {};
     ++frame_;
     if (state_.size() < index_.scene.objects().size()) {  // objects added: unknown, so tested
       State fresh;
@@ -41,7 +44,7 @@ class PerObjectCuller final : public Culler {
       state_.resize(index_.scene.objects().size(), fresh);
     }
     in_frustum_.clear();
-    collect_in_frustum_front_to_back(index_, view, in_frustum_, stats);
+    collect_in_frustum_front_to_back(index_, view, in_frustum_, result.nodes_visited);
     const float radius = near_plane_radius(view);
 
     // Pre-pass: the occluders, nearest first.
@@ -65,7 +68,7 @@ class PerObjectCuller final : public Culler {
         if (!s.started) {
           s.query = backend.issue_query(std::span<const Aabb>(&box, 1));
           s.started = true;
-          ++stats.query_batches;
+          ++counters_.query_batches;
         }
       } else {
         ++s.frames_without_test;
@@ -94,7 +97,7 @@ class PerObjectCuller final : public Culler {
         s.frames_without_test = interval_;
       }
     }
-    return stats;
+    return result;
   }
 
   // A running query is read now; its answer counts as it would have when
@@ -111,6 +114,7 @@ class PerObjectCuller final : public Culler {
   }
 
  private:
+  QueryCounters counters_;  // of the last frame
   struct State {
     std::uint32_t frames_without_test = 0;
     bool started = false;

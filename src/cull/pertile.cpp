@@ -17,13 +17,14 @@ class PerTileCuller final : public Culler {
   PerTileCuller(const SceneIndex& index, const PerTileConfig& c, const Options& o)
       : world_(tiled_world(index, "pertile")), cache_(index, "chcpp", o, c.evict) {}
 
-  FrameStats cull(const View& view, Backend& backend) override {
-    FrameStats stats;
-    cache_.begin_frame(++frame_, stats);
+  void visit_counters(const CounterVisitor& visit) const override { cache_.visit_counters(visit); }
+
+  FrameResult cull(const View& view, Backend& backend) override {
+    cache_.begin_frame(++frame_);
     cells_in_frustum(world_, view, true, cells_);
     for (TileCoord c : cells_) cache_.render(cache_.fetch(c), view, backend);
     cache_.end_frame();
-    return stats;
+    return cache_.result();
   }
   [[nodiscard]] std::span<const CullRegion> regions() const override { return cache_.regions(); }
 

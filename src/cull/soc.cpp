@@ -37,12 +37,15 @@ class SocCuller final : public Culler {
   SocCuller(const SceneIndex& index, const SocConfig& config)
       : index_(index), config_(config), occluders_(index.scene, config.occluders) {}
 
-  FrameStats cull(const View& view, Backend& backend) override {
-    FrameStats stats;
+  void visit_counters(const CounterVisitor& visit) const override { counters_.visit(visit); }
+
+  FrameResult cull(const View& view, Backend& backend) override {
+    FrameResult result;
+    BufferCounters& counters = counters_ = {};
     OcclusionBuffer& buffer = buffer_for(view);
     buffer.clear(view.clip);
     occluders_.begin_frame(view, buffer);
-    stats.buffer_texels = std::uint64_t(buffer.width()) * std::uint64_t(buffer.height());
+    counters.buffer_texels = std::uint64_t(buffer.width()) * std::uint64_t(buffer.height());
     queue_.clear();
     frustum_.begin(index_.bvh, view);
     const Bvh& bvh = index_.bvh;
@@ -51,9 +54,9 @@ class SocCuller final : public Culler {
     open.push(bvh, Bvh::root(), view.eye);
     while (!open.empty()) {
       const NodeId n = open.pop();
-      ++stats.nodes_visited;
+      ++result.nodes_visited;
       if (bvh.node(n).object_count == 0 || frustum_.outside(bvh, n)) continue;
-      if (n != Bvh::root() && hidden(buffer, bvh.node(n).bounds, view, stats)) continue;
+      if (n != Bvh::root() && hidden(buffer, bvh.node(n).bounds, view, counters)) continue;
       if (!bvh.is_leaf(n)) {
         open.push(bvh, Bvh::left(n), view.eye);
         open.push(bvh, bvh.right(n), view.eye);
@@ -64,13 +67,13 @@ class SocCuller final : public Culler {
       // A leaf of one object: its box is the node's, tested above (the root aside).
       const bool tested = leaf_.size() == 1 && bvh.node(n).object_count == 1 && n != Bvh::root();
       for (ObjectId id : leaf_) {
-        if (!tested && hidden(buffer, index_.scene.object(id).bounds, view, stats)) continue;
+        if (!tested && hidden(buffer, index_.scene.object(id).bounds, view, counters)) continue;
         queue_.push_back(id);
-        occluders_.rasterize_if_occluder(buffer, id, view, stats);
+        occluders_.rasterize_if_occluder(buffer, id, view, counters);
       }
     }
     if (!queue_.empty()) backend.render(queue_);
-    return stats;
+    return result;
   }
   [[nodiscard]] const OcclusionBuffer* occlusion_buffer() const override { return buffer_ ? &*buffer_ : nullptr; }
 
@@ -83,17 +86,18 @@ class SocCuller final : public Culler {
     return *buffer_;
   }
 
-  static bool hidden(OcclusionBuffer& buffer, const Aabb& box, const View& view, FrameStats& stats) {
+  static bool hidden(OcclusionBuffer& buffer, const Aabb& box, const View& view, BufferCounters& counters) {
     const auto start = Clock::now();
     const bool out = buffer.occluded(box, view.view_proj);
-    stats.test_ms += std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-    ++stats.boxes_tested;
+    counters.test_ms += std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+    ++counters.boxes_tested;
     return out;
   }
 
   SceneIndex index_;
   SocConfig config_;
   Occluders occluders_;
+  BufferCounters counters_;  // of the last frame
   std::optional<OcclusionBuffer> buffer_;
   FrustumCache frustum_;
   std::vector<ObjectId> queue_, leaf_;

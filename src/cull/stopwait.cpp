@@ -13,15 +13,18 @@ class StopWaitCuller final : public Culler {
  public:
   StopWaitCuller(const SceneIndex& index, const QueryOptions& common) : index_(index), common_(common) {}
 
-  FrameStats cull(const View& view, Backend& backend) override {
-    FrameStats stats;
+  void visit_counters(const CounterVisitor& visit) const override { counters_.visit(visit); }
+
+  FrameResult cull(const View& view, Backend& backend) override {
+    FrameResult result;
+    counters_ = {};
     const Bvh& bvh = index_.bvh;
     const float radius = near_plane_radius(view);
     DistanceQueue queue;
     queue.push(bvh, Bvh::root(), view.eye);
     while (!queue.empty()) {
       const NodeId n = queue.pop();
-      ++stats.nodes_visited;
+      ++result.nodes_visited;
       const BvhNode& node = bvh.node(n);
       if (node.object_count == 0 || view.frustum.classify(node.bounds) == Containment::outside ||
           holds_no_sample(node.bounds, view))
@@ -30,7 +33,7 @@ class StopWaitCuller final : public Culler {
         boxes_.clear();
         append_query_boxes(index_, n, {}, boxes_);
         const QueryId q = backend.issue_query(boxes_);
-        ++stats.query_batches;
+        ++counters_.query_batches;
         if (backend.result(q) <= common_.threshold) continue;  // stop and wait
       }
       if (bvh.is_leaf(n, common_.virtual_leaf_triangles)) {
@@ -42,10 +45,11 @@ class StopWaitCuller final : public Culler {
         queue.push(bvh, bvh.right(n), view.eye);
       }
     }
-    return stats;
+    return result;
   }
 
  private:
+  QueryCounters counters_;  // of the last frame
   SceneIndex index_;
   QueryOptions common_;
   std::vector<Aabb> boxes_;

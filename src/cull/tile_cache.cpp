@@ -12,10 +12,28 @@ namespace occull::detail {
 TileCache::TileCache(const SceneIndex& index, std::string local, const Options& options, int evict_after)
     : index_(index), local_(std::move(local)), options_(options), evict_after_(evict_after) {}
 
-void TileCache::begin_frame(std::uint64_t frame, FrameStats& stats) {
+void TileCounters::visit(const CounterVisitor& visit) const {
+  visit("tiles_rendered", double(tiles_rendered));
+  visit("tile_queries", double(tile_queries));
+  visit("tile_postponed", double(tile_postponed));
+  visit("tile_prediction_failures", double(tile_prediction_failures));
+  visit("tiles_instantiated", double(tiles_instantiated));
+  visit("tiles_evicted", double(tiles_evicted));
+  visit("tile_cache", double(tile_cache));
+  visit("instantiate_ms", instantiate_ms);
+}
+
+void TileCache::begin_frame(std::uint64_t frame) {
   frame_ = frame;
-  stats_ = &stats;
+  counters_ = {};
+  nodes_visited_ = 0;
+  for (auto& [name, value] : local_counters_) value = 0.0;
   regions_.clear();
+}
+
+void TileCache::visit_counters(const CounterVisitor& visit) const {
+  counters_.visit(visit);
+  for (const auto& [name, value] : local_counters_) visit(name, value);
 }
 
 TileInstance& TileCache::fetch(TileCoord c) {
@@ -32,27 +50,26 @@ TileInstance& TileCache::fetch(TileCoord c) {
     t.bvh = std::make_unique<Bvh>(tile.bvh.instance(world.origin(c), t.first_object));
     if (!local_.empty()) t.local = make_culler(local_, SceneIndex{index_.scene, *t.bvh, nullptr}, options_);
     it = cache_.emplace(c, std::move(t)).first;
-    if (stats_) {
-      ++stats_->tiles_instantiated;
-      stats_->instantiate_ms +=
-          std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-    }
+    ++counters_.tiles_instantiated;
+    counters_.instantiate_ms += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   }
   it->second.last_used = frame_;
   return it->second;
 }
 
 void TileCache::render(TileInstance& t, const View& view, Backend& backend) {
-  if (stats_) ++stats_->tiles_rendered;
+  ++counters_.tiles_rendered;
   note(index_.world->tile_box_at(t.coord), true);
   if (t.local) {
-    const FrameStats s = t.local->render_frame(view, backend);
-    if (stats_) {
-      stats_->nodes_visited += s.nodes_visited;
-      stats_->multiqueries += s.multiqueries;
-      stats_->failed_multiqueries += s.failed_multiqueries;
-      stats_->query_batches += s.query_batches;
-    }
+    nodes_visited_ += t.local->render_frame(view, backend).nodes_visited;
+    t.local->visit_counters([this](std::string_view name, double value) {
+      const auto it = std::find_if(local_counters_.begin(), local_counters_.end(),
+                                   [&](const auto& c) { return c.first == name; });
+      if (it == local_counters_.end())
+        local_counters_.emplace_back(name, value);
+      else
+        it->second += value;
+    });
     return;
   }
   all_.clear();
@@ -66,13 +83,12 @@ void TileCache::end_frame() {
                        !index_.world->in_window(it->first);
     if (stale) {
       it = cache_.erase(it);
-      if (stats_) ++stats_->tiles_evicted;
+      ++counters_.tiles_evicted;
     } else {
       ++it;
     }
   }
-  if (stats_) stats_->tile_cache = cache_.size();
-  stats_ = nullptr;
+  counters_.tile_cache = cache_.size();
 }
 
 const TiledWorld& tiled_world(const SceneIndex& index, std::string_view algorithm) {

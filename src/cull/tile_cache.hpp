@@ -9,6 +9,9 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <string_view>
+#include <utility>
+#include <vector>
 
 namespace occull::detail {
 
@@ -22,27 +25,49 @@ struct TileInstance {
   std::uint64_t last_used = 0;        ///< frame it was last fetched in
 };
 
+/// The counters of a tiled-world culler's frame beyond FrameResult.
+struct TileCounters {
+  std::uint64_t tiles_rendered = 0;            ///< tile instances drawn
+  std::uint64_t tile_queries = 0;              ///< queries of the common box at a tile (tiles)
+  std::uint64_t tile_postponed = 0;            ///< tiles drawn on last frame's visibility, their query pending
+  std::uint64_t tile_prediction_failures = 0;  ///< postponed queries still without a result at the frame's end
+  std::uint64_t tiles_instantiated = 0;        ///< tile instances created in the frame
+  std::uint64_t tiles_evicted = 0;             ///< ... and freed, unused for the eviction time
+  std::uint64_t tile_cache = 0;                ///< tile instances held after the frame
+  double instantiate_ms = 0.0;                 ///< time spent creating tile instances, ms
+
+  void visit(const CounterVisitor& visit) const;
+};
+
 class TileCache {
  public:
   /// `local`: the algorithm culling inside a tile ("chcpp"), or empty for
   /// none; it gets `options`. `evict_after`: frames an instance may go unused.
   TileCache(const SceneIndex& index, std::string local, const Options& options, int evict_after);
 
-  /// Starts frame `frame` (> every earlier one) and counts into `stats`.
-  void begin_frame(std::uint64_t frame, FrameStats& stats);
+  /// Starts frame `frame` (> every earlier one); its counters start at 0.
+  void begin_frame(std::uint64_t frame);
   /// fetchBVHInstance: the instance of cell `c`, created on first use.
   /// Precondition: `c` is in the world's window.
   TileInstance& fetch(TileCoord c);
   /// Frees instances unused for `evict_after` frames (after the frame's
-  /// last fetch) and records the cache size in the frame's stats.
+  /// last fetch) and records the cache size in the frame's counters.
   void end_frame();
   /// Draws a fetched instance: through its local culler, or all its objects.
-  /// Records its tile's box as a visible region.
+  /// Records its tile's box as a visible region, and adds the local
+  /// culler's nodes and counters to the frame's.
   void render(TileInstance& t, const View& view, Backend& backend);
   /// Records a region of this frame: a cell's box, drawn or found hidden.
   void note(const Aabb& box, bool visible) { regions_.push_back({box, visible}); }
   /// This frame's regions (Culler::regions), cleared by begin_frame().
   [[nodiscard]] std::span<const CullRegion> regions() const noexcept { return regions_; }
+
+  /// The frame's counters (the tiled-world culler adds its own).
+  [[nodiscard]] TileCounters& counters() noexcept { return counters_; }
+  /// The frame's result: the nodes the local cullers visited.
+  [[nodiscard]] FrameResult result() const noexcept { return {.nodes_visited = nodes_visited_}; }
+  /// The last frame's counters: the tiles' and the sums of the local cullers'.
+  void visit_counters(const CounterVisitor& visit) const;
 
   [[nodiscard]] std::size_t size() const noexcept { return cache_.size(); }
   [[nodiscard]] int evict_after() const noexcept { return evict_after_; }
@@ -54,7 +79,9 @@ class TileCache {
   int evict_after_;
   std::map<TileCoord, TileInstance> cache_;
   std::uint64_t frame_ = 0;
-  FrameStats* stats_ = nullptr;
+  TileCounters counters_;
+  std::uint64_t nodes_visited_ = 0;
+  std::vector<std::pair<std::string_view, double>> local_counters_;  // summed over the frame's tiles
   std::vector<ObjectId> all_;
   std::vector<CullRegion> regions_;
 };

@@ -44,13 +44,13 @@ class TilesCuller final : public Culler {
         common_box_(c.common_box),
         requery_(c.requery) {}
 
-  FrameStats cull(const View& view, Backend& backend) override {
-    FrameStats stats;
-    stats_ = &stats;
+  void visit_counters(const CounterVisitor& visit) const override { cache_.visit_counters(visit); }
+
+  FrameResult cull(const View& view, Backend& backend) override {
     backend_ = &backend;
     view_ = &view;
     near_radius_ = near_plane_radius(view);
-    cache_.begin_frame(++frame_, stats);
+    cache_.begin_frame(++frame_);
     release(backend);  // the queries whose results were not ready at the last frame's end
 
     pending_.clear();
@@ -65,10 +65,9 @@ class TilesCuller final : public Culler {
     update_postponed_queries();
     cache_.end_frame();
     prune();
-    stats_ = nullptr;
     backend_ = nullptr;  // this frame's only: queries left over are in stale_
     view_ = nullptr;
-    return stats;
+    return cache_.result();
   }
   [[nodiscard]] std::span<const CullRegion> regions() const override { return cache_.regions(); }
 
@@ -122,7 +121,7 @@ class TilesCuller final : public Culler {
         continue;
       }
       pending_.push_back({backend_->issue_query(std::span<const Aabb>(&box, 1)), n, true, box});
-      ++stats_->tile_queries;
+      ++cache_.counters().tile_queries;
     }
   }
 
@@ -138,7 +137,7 @@ class TilesCuller final : public Culler {
       }
       if (!backend_->result_available(p.query) && s.visible_for == frame_) {
         postponed_.push_back(p);
-        ++stats_->tile_postponed;
+        ++cache_.counters().tile_postponed;
         return p.cell;
       }
       if (backend_->result(p.query) > 0) {
@@ -159,7 +158,7 @@ class TilesCuller final : public Culler {
         s.visible_for = backend_->result(p.query) > 0 ? frame_ + 1 : 0;
       } else {
         s.visible_for = 0;
-        ++stats_->tile_prediction_failures;
+        ++cache_.counters().tile_prediction_failures;
         stale_.push_back(p.query);
       }
     }
@@ -187,7 +186,6 @@ class TilesCuller final : public Culler {
   std::deque<Pending> pending_;    // Q: queries in issue order (results come back in order)
   std::vector<Pending> postponed_; // P
   std::vector<QueryId> stale_;     // postponed queries given up on at the last frame's end
-  FrameStats* stats_ = nullptr;
   Backend* backend_ = nullptr;  // during render_frame only
   const View* view_ = nullptr;  // during render_frame only
   float near_radius_ = 0.0f;

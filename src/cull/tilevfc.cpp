@@ -16,20 +16,22 @@ class TileVfcCuller final : public Culler {
   TileVfcCuller(const SceneIndex& index, const TileVfcConfig& c, const Options& o)
       : index_(index), world_(tiled_world(index, "tilevfc")), cache_(index, "", o, c.evict) {}
 
-  FrameStats cull(const View& view, Backend& backend) override {
-    FrameStats stats;
-    cache_.begin_frame(++frame_, stats);
+  void visit_counters(const CounterVisitor& visit) const override { cache_.visit_counters(visit); }
+
+  FrameResult cull(const View& view, Backend& backend) override {
+    FrameResult result;
+    cache_.begin_frame(++frame_);
     cells_in_frustum(world_, view, true, cells_);
     queue_.clear();
     for (TileCoord c : cells_) {
       TileInstance& t = cache_.fetch(c);
-      collect_in_frustum_front_to_back(SceneIndex{index_.scene, *t.bvh, nullptr}, view, queue_, stats, /*subpixel=*/false);  // the baseline: frustum only
-      ++stats.tiles_rendered;
+      collect_in_frustum_front_to_back(SceneIndex{index_.scene, *t.bvh, nullptr}, view, queue_, result.nodes_visited, /*subpixel=*/false);  // the baseline: frustum only
+      ++cache_.counters().tiles_rendered;
       cache_.note(world_.tile_box_at(c), true);
     }
     if (!queue_.empty()) backend.render(queue_);
     cache_.end_frame();
-    return stats;
+    return result;
   }
   [[nodiscard]] std::span<const CullRegion> regions() const override { return cache_.regions(); }
 

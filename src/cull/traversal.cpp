@@ -24,9 +24,9 @@ void append_objects_in_frustum(const SceneIndex& index, NodeId n, const View& vi
 namespace {
 
 void collect(const SceneIndex& index, NodeId n, std::uint32_t planes, const View& view, bool subpixel,
-             std::vector<ObjectId>& out, FrameStats& stats) {
+             std::vector<ObjectId>& out, std::uint64_t& nodes_visited) {
   const Bvh& bvh = index.bvh;
-  ++stats.nodes_visited;
+  ++nodes_visited;
   if (bvh.node(n).object_count == 0) return;
   if (planes != 0 && view.frustum.classify(bvh.node(n).bounds, planes) == Containment::outside)
     return;
@@ -36,14 +36,14 @@ void collect(const SceneIndex& index, NodeId n, std::uint32_t planes, const View
       if (in_frustum(index.scene.object(id).bounds, view, planes, subpixel)) out.push_back(id);
     return;
   }
-  for (NodeId c : children_front_to_back(bvh, n, view.eye)) collect(index, c, planes, view, subpixel, out, stats);
+  for (NodeId c : children_front_to_back(bvh, n, view.eye)) collect(index, c, planes, view, subpixel, out, nodes_visited);
 }
 
 }  // namespace
 
 void collect_in_frustum_front_to_back(const SceneIndex& index, const View& view,
-                                      std::vector<ObjectId>& out, FrameStats& stats, bool subpixel) {
-  collect(index, Bvh::root(), Frustum::all_planes, view, subpixel, out, stats);
+                                      std::vector<ObjectId>& out, std::uint64_t& nodes_visited, bool subpixel) {
+  collect(index, Bvh::root(), Frustum::all_planes, view, subpixel, out, nodes_visited);
 }
 
 }  // namespace occull::detail

@@ -52,25 +52,40 @@ inline std::array<NodeId, 2> children_front_to_back(const Bvh& bvh, NodeId n, co
   return {l, r};
 }
 
+/// The counters of a query culler's frame beyond FrameResult.
+struct QueryCounters {
+  std::uint64_t query_batches = 0;        ///< batches of queries issued together
+  std::uint64_t multiqueries = 0;         ///< queries covering more than one node
+  std::uint64_t failed_multiqueries = 0;  ///< multiqueries that came back visible
+
+  void visit(const CounterVisitor& visit) const {
+    visit("query_batches", double(query_batches));
+    visit("multiqueries", double(multiqueries));
+    visit("failed_multiqueries", double(failed_multiqueries));
+  }
+};
+
 /// What a hierarchical culler knows during one frame: its counters, the
 /// view and the backend, and the near-plane radius of the eye-inside rule.
 struct FrameContext {
-  FrameStats stats;
+  std::uint64_t nodes_visited = 0;
+  QueryCounters counters;  ///< kept after the frame, for Culler::visit_counters
   const View* view = nullptr;   ///< during a frame only
   Backend* backend = nullptr;   ///< during a frame only: no culler keeps a backend between frames
   float near_radius = 0.0f;
 
   void begin(const View& v, Backend& b) {
-    stats = {};
+    nodes_visited = 0;
+    counters = {};
     view = &v;
     backend = &b;
     near_radius = near_plane_radius(v);
   }
-  /// Ends the frame: forgets the view and backend; returns the frame's stats.
-  FrameStats end() {
+  /// Ends the frame: forgets the view and backend; returns the frame's result.
+  FrameResult end() {
     view = nullptr;
     backend = nullptr;
-    return stats;
+    return {.nodes_visited = nodes_visited};
   }
 };
 
@@ -237,9 +252,10 @@ inline bool near_eye(const Aabb& box, const View& view, float radius) {
 /// outside the frustum, nearest subtree first (plane masks skip the planes a
 /// node is fully inside), and, with `subpixel`, holds a sample
 /// (holds_no_sample skips whole subtrees). Counts visited nodes in
-/// stats.nodes_visited.
+/// `nodes_visited`.
 void collect_in_frustum_front_to_back(const SceneIndex& index, const View& view,
-                                      std::vector<ObjectId>& out, FrameStats& stats, bool subpixel = true);
+                                      std::vector<ObjectId>& out, std::uint64_t& nodes_visited,
+                                      bool subpixel = true);
 
 /// Appends the objects of node `n` whose boxes are not outside the frustum
 /// and hold a sample (occull/view.hpp holds_no_sample: exact sub-pixel
@@ -266,12 +282,17 @@ class CpuTestedCuller : public Culler, public Resumable {
   CpuTestedCuller(const SceneIndex& index, const QueryOptions& options)
       : cpu_test_(options.cpu_test ? std::make_unique<CpuTestBackend>(index.scene) : nullptr) {}
 
-  FrameStats cull(const View& view, Backend& backend) final {
+  FrameResult cull(const View& view, Backend& backend) final {
     if (!cpu_test_) return cull_frame(view, backend);
     cpu_test_->begin_frame(backend, view);
-    FrameStats stats = cull_frame(view, *cpu_test_);
-    cpu_test_->end_frame(stats);
-    return stats;
+    const FrameResult result = cull_frame(view, *cpu_test_);
+    cpu_test_->end_frame();
+    return result;
+  }
+  /// The first test's counters (the occlusion buffer's), when it is on; a
+  /// culler adds its own.
+  void visit_counters(const CounterVisitor& visit) const override {
+    if (cpu_test_) cpu_test_->visit_counters(visit);
   }
   [[nodiscard]] const OcclusionBuffer* occlusion_buffer() const final {
     return cpu_test_ ? cpu_test_->buffer() : nullptr;
@@ -299,7 +320,7 @@ class CpuTestedCuller : public Culler, public Resumable {
   }
 
   /// The culler's frame, through the first test when it is on.
-  virtual FrameStats cull_frame(const View& view, Backend& backend) = 0;
+  virtual FrameResult cull_frame(const View& view, Backend& backend) = 0;
 
  private:
   std::unique_ptr<CpuTestBackend> cpu_test_;

@@ -14,12 +14,12 @@ class VfcCuller final : public Culler {
  public:
   explicit VfcCuller(const SceneIndex& index) : index_(index) {}
 
-  FrameStats cull(const View& view, Backend& backend) override {
-    FrameStats stats;
+  FrameResult cull(const View& view, Backend& backend) override {
+    FrameResult result;
     queue_.clear();
-    collect_in_frustum_front_to_back(index_, view, queue_, stats, /*subpixel=*/false);  // the baseline: frustum only
+    collect_in_frustum_front_to_back(index_, view, queue_, result.nodes_visited, /*subpixel=*/false);  // the baseline: frustum only
     if (!queue_.empty()) backend.render(queue_);
-    return stats;
+    return result;
   }
 
  private:

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <array>
+#include <stdexcept>
+#include <string>
 #include <type_traits>
 
 namespace occull {
@@ -167,6 +169,33 @@ void copy_backend_counters(const BackendStats& during, FrameStats& frame) noexce
         },
         c.frame);
   }
+}
+
+void copy_culler_counters(const FrameResult& result, const Culler& culler, FrameStats& frame) {
+  frame.nodes_visited = result.nodes_visited;
+  frame.cpu_ms = result.cpu_ms;
+  culler.visit_counters([&frame](std::string_view name, double value) { set_counter(frame, name, value); });
+}
+
+void set_counter(FrameStats& frame, std::string_view name, double value) {
+  const Counter* c = find_counter(name);
+  if (!c || !std::holds_alternative<std::monostate>(c->backend))
+    throw std::logic_error("a culler reported the counter '" + std::string(name) + "', which " +
+                           (c ? "the backend fills" : "the counter table (src/lab/counters.cpp) does not declare"));
+  std::visit(
+      [&](auto member) {
+        using T = std::remove_reference_t<decltype(frame.*member)>;
+        frame.*member = static_cast<T>(value);
+      },
+      c->frame);
+}
+
+FrameMeasure measure_of(const FrameStats& frame) noexcept {
+  return {.frame_ms = frame.frame_ms,
+          .cpu_ms = frame.cpu_ms,
+          .wait_ms = frame.wait_ms,
+          .draw_calls = frame.draw_calls,
+          .triangles = frame.triangles};
 }
 
 void add_view(FrameStats& sum, const FrameStats& view) noexcept {

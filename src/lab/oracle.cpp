@@ -4,7 +4,7 @@
 
 namespace occull::detail {
 
-FrameStats OracleCuller::cull(const View& view, Backend& backend) {
+FrameResult OracleCuller::cull(const View& view, Backend& backend) {
   // Nearest first, as a front-to-back render queue would submit them; the
   // backend then sorts by material (stably).
   std::vector<std::pair<float, ObjectId>> order;

@@ -16,7 +16,7 @@ class OracleCuller final : public Culler {
   /// The visible set of the next frame (from the untimed truth pass).
   void set_visible(std::vector<ObjectId> visible) { visible_ = std::move(visible); }
 
-  FrameStats cull(const View& view, Backend& backend) override;
+  FrameResult cull(const View& view, Backend& backend) override;
 
  private:
   const Scene& scene_;

@@ -196,11 +196,10 @@ FrameStats Session::run_frame(Culler& culler, const View& view, double time_s, F
   if (logger_) logger_->log_into(log);
   Backend& backend = log ? static_cast<Backend&>(*logger_) : this->backend();
   const BackendStats before = backend.stats();
-  const auto c0 = Clock::now();
-  FrameStats s = culler.render_frame(view, backend);
-  const auto c1 = Clock::now();
+  const FrameResult result = culler.render_frame(view, backend);
+  FrameStats s;
+  copy_culler_counters(result, culler, s);
   if (logger_) logger_->log_into(nullptr);  // `log` is this frame's only
-  const BackendStats during = backend.stats() - before;
   context_->check("a culler's frame");  // before end_frame's own glGetError, which knows less
   s.gpu_ms = renderer_->end_frame();
   const auto t1 = Clock::now();
@@ -211,10 +210,9 @@ FrameStats Session::run_frame(Culler& culler, const View& view, double time_s, F
   s.major_faults = u1.major_faults - u0.major_faults;
   s.kernel_ms = u1.kernel_ms - u0.kernel_ms;
   s.frame_ms = ms_between(t0, t1);
-  s.cpu_ms = std::max(0.0, ms_between(c0, c1) - during.backend_ms);
   copy_backend_counters(d, s);
   context_->check("the end of a frame");
-  culler.frame_finished(s);
+  culler.frame_finished(measure_of(s));
   return s;
 }
 
@@ -272,8 +270,10 @@ std::unique_ptr<Culler> Session::make(std::string_view spec, const Options& opti
 
 CullerContext Session::culler_context(const std::function<void(const std::string&)>& progress) {
   CullerContext context;  // nohc: the calibrated profile, unless an option names a file
-  context.read_profile = load_profile;
-  context.nohc_profile_source = [this, progress]() -> const HardwareProfile& { return hardware_profile(progress); };
+  context.hardware_profile = [this, progress](const std::string& file) -> std::optional<HardwareProfile> {
+    if (!file.empty()) return load_profile(file);
+    return hardware_profile(progress);
+  };
   return context;
 }
 

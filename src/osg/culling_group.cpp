@@ -165,7 +165,7 @@ const CameraFrame* OcclusionCullingGroup::last_frame(const ::osg::Camera* camera
   return it == state_->cameras.end() ? nullptr : &it->second.frame;
 }
 
-void OcclusionCullingGroup::frame_finished(const ::osg::Camera* camera, const FrameStats& measured) {
+void OcclusionCullingGroup::frame_finished(const ::osg::Camera* camera, const FrameMeasure& measured) {
   std::lock_guard lock(mutex_);
   const auto it = state_->cameras.find(camera);
   if (it != state_->cameras.end() && it->second.culler) it->second.culler->frame_finished(measured);
@@ -289,20 +289,25 @@ void OcclusionCullingGroup::draw(::osg::RenderInfo& info) {
     if (!s.warned_view) OSG_WARN << "occull: OcclusionCullingGroup draws everything: " << e.what() << std::endl;
     s.warned_view = true;
   }
-  const auto t0 = Clock::now();
   if (view) {
     c.frame.culler = c.culler->render_frame(*view, *c.backend);
+    c.frame.counters.clear();
+    c.culler->visit_counters([&](std::string_view name, double value) { c.frame.counters.emplace_back(name, value); });
     const auto drawn = c.culler->drawn_objects();
     c.frame.drawn.assign(drawn.begin(), drawn.end());
   } else {
+    const auto t0 = Clock::now();
     for (ObjectId id = 0; id < instances_.size(); ++id)
       if (instances_[id].drawable) c.frame.drawn.push_back(id);
+    const BackendStats drawing = c.backend->stats();
     c.backend->render(c.frame.drawn);
+    const double wall_ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+    c.frame.culler = {.objects_drawn = c.frame.drawn.size(),
+                      .cpu_ms = std::max(0.0, wall_ms - (c.backend->stats().backend_ms - drawing.backend_ms))};
+    c.frame.counters.clear();
   }
-  const double culler_wall_ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
   c.backend->end_frame();
   c.frame.backend = c.backend->stats() - before;
-  c.frame.culler.cpu_ms = std::max(0.0, culler_wall_ms - c.frame.backend.backend_ms);
 }
 
 void OcclusionCullingGroup::releaseGLObjects(::osg::State* state) const {

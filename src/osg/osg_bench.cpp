@@ -328,11 +328,10 @@ BenchResult run_osg_bench(const OsgBenchConfig& config, const ProgressFn& progre
         kept.clear();
         const double frame_ms = device->frame(session.view_at(path, k, config.frames), t);
         if (graph.group) {  // the frame's measured time reaches the camera's culler, as Session does for occull's rows
-          FrameStats measured;
+          FrameMeasure measured;
           if (const CameraFrame* f = graph.group->last_frame(camera)) {
-            measured = f->culler;
-            measured.draw_calls = measured.objects_rendered = f->drawn.size();
-            measured.triangles = 0;
+            measured.cpu_ms = f->culler.cpu_ms;
+            measured.draw_calls = f->drawn.size();
             for (ObjectId id : f->drawn) measured.triangles += scene.object(id).triangles;
           }
           measured.frame_ms = frame_ms;
@@ -345,8 +344,9 @@ BenchResult run_osg_bench(const OsgBenchConfig& config, const ProgressFn& progre
         if (graph.group) {
           drawn_by_group(*graph.group, camera, drawn);
           if (const CameraFrame* f = graph.group->last_frame(camera)) {
-            stats = f->culler;
-            stats.cpu_ms += f->gather_ms;  // the group's own CPU time: its gathering and its culler
+            stats.nodes_visited = f->culler.nodes_visited;
+            for (const auto& [name, value] : f->counters) set_counter(stats, name, value);
+            stats.cpu_ms = f->culler.cpu_ms + f->gather_ms;  // the group's own CPU time: its gathering and its culler
             copy_backend_counters(f->backend, stats);
           }
         } else {

@@ -51,7 +51,6 @@
 #include "occull/culler.hpp"
 #include "occull/error.hpp"
 #include "occull/backend.hpp"
-#include "occull/stats.hpp"
 
 #include <osg/Group>
 #include <osg/NodeVisitor>
@@ -62,6 +61,8 @@
 #include <mutex>
 #include <span>
 #include <string>
+#include <string_view>
+#include <utility>
 #include <vector>
 
 namespace osgOccull {
@@ -97,9 +98,11 @@ struct Instance {
 /// What one camera's culler did in its last frame.
 struct CameraFrame {
   std::vector<occull::ObjectId> drawn;  ///< objects drawn (ascending; ids of instances())
-  occull::FrameStats culler;            ///< the culler's own counters; cpu_ms: its time outside backend calls, ms
+  occull::FrameResult culler;           ///< what the culler returned (cpu_ms: its time outside backend calls, ms)
+  /// Its algorithm's own counters (occull::Culler::visit_counters), by name.
+  std::vector<std::pair<std::string_view, double>> counters;
   occull::BackendStats backend;         ///< what the backend counted in the frame (draws, queries, waits, ...)
-  std::vector<std::string> choices;     ///< the culler's Culler::choices(): auto's candidates, in order (culler.auto_choice indexes them from 1)
+  std::vector<std::string> choices;     ///< the culler's Culler::choices(): auto's candidates, in order (the counter "auto_choice" indexes them from 1)
   /// Time the group spent gathering the graph into its scene this frame
   /// (walk, changes, refit), ms; counted for the first camera drawn after it.
   double gather_ms = 0.0;
@@ -160,7 +163,7 @@ class OcclusionCullingGroup : public ::osg::Group {
   /// it; without it they fall back to their own time inside the draw, which
   /// in OSG misses the draws the GPU runs after it (docs/osg.md). Ignored
   /// for a camera the group has not drawn. Thread-safe with the group's draw.
-  void frame_finished(const ::osg::Camera* camera, const occull::FrameStats& measured);
+  void frame_finished(const ::osg::Camera* camera, const occull::FrameMeasure& measured);
 
  protected:
   ~OcclusionCullingGroup() override;
