@@ -3,6 +3,7 @@
 #include "occull/configs.hpp"
 #include "occull/culler.hpp"
 #include "occull/error.hpp"
+#include "occull/grid_views.hpp"
 
 #include "test_util.hpp"
 
@@ -83,6 +84,26 @@ TEST(TypedConfig, MakesTheCullerItsSpecMakes) {
   }
   // The cases differ from each other: the comparison is not of one culler with itself.
   EXPECT_GE(differing, cases.size() - 2);
+}
+
+TEST(TypedConfig, MakesTheSplitScreenItsSpecMakes) {
+  Scene scene = test::box_scene(test::scattered_boxes(150));
+  const Bvh bvh = Bvh::build(scene);
+  const SceneIndex index{scene, bvh};
+  const auto compare = [&](std::string_view spec, std::unique_ptr<SplitScreen> typed) {
+    auto from_spec = make_split_screen(spec, index, 2);
+    ASSERT_EQ(typed->size(), 2) << spec;
+    EXPECT_EQ(dynamic_cast<GridViews*>(typed.get()) != nullptr, dynamic_cast<GridViews*>(from_spec.get()) != nullptr)
+        << spec << ": the views share state as the spec's do";
+    for (int k = 0; k < 2; ++k)
+      expect_same_trace(trace(typed->view(k)), trace(from_spec->view(k)), std::string(spec) + ", view " + std::to_string(k));
+  };
+  compare("chcpp:batch=3:multiquery=off", make_split_screen(ChcppConfig{.batch = 3, .multiquery = false}, index, 2));
+  compare("grid:cap=7:split=even", make_split_screen(GridConfig{.cap = 7, .split = SplitPolicy::even}, index, 2));
+  auto grid = make_split_screen(GridConfig{.cap = 7, .split = SplitPolicy::even}, index, 2);
+  EXPECT_EQ(dynamic_cast<GridViews&>(*grid).budget().total(), 7);
+  EXPECT_THROW((void)make_split_screen(GridConfig{.cap = 0}, index, 2), InputError);
+  EXPECT_THROW((void)make_split_screen(ChcppConfig{}, index, 17), InputError);
 }
 
 TEST(TypedConfig, AValueOutsideItsRangeThrowsNamingItsOption) {

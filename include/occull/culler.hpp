@@ -346,4 +346,26 @@ class SplitScreen {
                                                              int views, const Options& options = {},
                                                              const CullerContext& context = {});
 
+namespace detail {
+/// `views` cullers of `algorithm`, one make() each, for the typed
+/// make_split_screen(). Throws InputError for a view count out of range.
+std::unique_ptr<SplitScreen> independent_views(std::string_view algorithm, int views,
+                                               const std::function<std::unique_ptr<Culler>()>& make);
+}  // namespace detail
+
+/// The cullers of `views` views (1 to 16) of one frame from a typed config,
+/// as make_culler(config) makes one: `make_split_screen(ChcppConfig{.batch =
+/// 20}, {scene, bvh}, 2)`. Throws InputError as make_culler() does, and for
+/// a view count out of range.
+template <class Config>
+  requires requires { Config::algorithm; }
+[[nodiscard]] std::unique_ptr<SplitScreen> make_split_screen(const Config& config, const SceneIndex& index, int views,
+                                                             const CullerContext& context = {}) {
+  return detail::independent_views(Config::algorithm, views,
+                                   [&] { return make_culler(config, index, context); });
+}
+/// `grid`'s views share one grid and one query cap (occull/grid_views.hpp).
+[[nodiscard]] std::unique_ptr<SplitScreen> make_split_screen(const GridConfig& config, const SceneIndex& index,
+                                                             int views, const CullerContext& context = {});
+
 }  // namespace occull

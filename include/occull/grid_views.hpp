@@ -116,6 +116,9 @@ class GridViews final : public SplitScreen {
   /// Preconditions: index.scene outlives this object; 1 <= views <= 16.
   /// Throws InputError for a bad option.
   GridViews(const SceneIndex& index, int views, const Options& options = {});
+  /// The same from a typed config (make_split_screen(GridConfig, ...)).
+  /// Throws InputError for a value outside its option's range.
+  GridViews(const SceneIndex& index, int views, const GridConfig& config);
   ~GridViews();
   GridViews(const GridViews&) = delete;
   GridViews& operator=(const GridViews&) = delete;

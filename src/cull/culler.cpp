@@ -353,6 +353,21 @@ std::unique_ptr<SplitScreen> make_split_screen(std::string_view spec_text, const
   return std::make_unique<IndependentViews>(std::move(cullers));
 }
 
+namespace detail {
+
+std::unique_ptr<SplitScreen> independent_views(std::string_view algorithm, int views,
+                                               const std::function<std::unique_ptr<Culler>()>& make) {
+  if (views < 1 || views > 16) throw InputError(detail::format("{} views: must be in [1, 16]", views));
+  if (find_algorithm(algorithm).shares_views)
+    throw std::logic_error(detail::format("{}'s views share state: make_split_screen needs an overload for its config",
+                                          algorithm));
+  std::vector<std::unique_ptr<Culler>> cullers;
+  for (int k = 0; k < views; ++k) cullers.push_back(make());
+  return std::make_unique<IndependentViews>(std::move(cullers));
+}
+
+}  // namespace detail
+
 std::unique_ptr<Culler> make_culler(const NoneConfig& config, const SceneIndex& index, const CullerContext& context) {
   return make_configured(config, index, context);
 }

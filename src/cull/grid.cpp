@@ -453,10 +453,12 @@ void QueryBudget::split() {
   for (int& a : allowance_) a = std::max(a, 1);
 }
 
-GridViews::GridViews(const SceneIndex& index, int views, const Options& options) {
+GridViews::GridViews(const SceneIndex& index, int views, const Options& options)
+    : GridViews(index, views, (check_options(options), detail::grid_table().parse(options, "grid"))) {}
+
+GridViews::GridViews(const SceneIndex& index, int views, const GridConfig& c) {
   if (views < 1 || views > 16) throw InputError(detail::format("{} views: must be in [1, 16]", views));
-  check_options(options);
-  const GridConfig c = detail::grid_table().parse(options, "grid");
+  detail::grid_table().check(c, "grid");
   grid_ = std::make_shared<UniformGrid>(UniformGrid::of_scene(index.scene, c.cell));
   budget_ = std::make_shared<QueryBudget>(std::max(c.cap, views), views, c.split_floor, c.split);
   for (int k = 0; k < views; ++k) {
@@ -467,5 +469,10 @@ GridViews::GridViews(const SceneIndex& index, int views, const Options& options)
 }
 
 GridViews::~GridViews() = default;
+
+std::unique_ptr<SplitScreen> make_split_screen(const GridConfig& config, const SceneIndex& index, int views,
+                                               const CullerContext&) {
+  return std::make_unique<GridViews>(index, views, config);
+}
 
 }  // namespace occull
