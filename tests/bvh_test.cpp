@@ -1,4 +1,5 @@
 #include "occull/bvh.hpp"
+#include "occull/motion.hpp"
 #include "test_util.hpp"
 
 #include <gtest/gtest.h>
@@ -101,16 +102,17 @@ TEST(Bvh, RefitAfterMovesKeepsBoundsValidAndTight) {
   for (const Aabb& b : random_boxes(200, 5))
     scene.add_object(scene.add_mesh(test::box_mesh(b)), mat, glm::mat4(1), OccluderClass::always);
   const MeshId car = scene.add_mesh(test::box_mesh({{0, 0, 0}, {2, 1, 1}}));
+  std::vector<ScriptedObject> cars;
   for (int i = 0; i < 30; ++i) {
     Motion m;
     m.waypoints = {{-80.0f + 5.0f * float(i), 0, -80}, {80, 0, -80}, {80, 0, 80}};
     m.speed = 7.0f + float(i);
-    scene.add_dynamic_object(car, mat, m, OccluderClass::sometimes);
+    add_scripted_object(scene, cars, car, mat, m, OccluderClass::sometimes);
   }
   Bvh bvh = Bvh::build(scene);
   const std::vector<BvhNode> before(bvh.nodes().begin(), bvh.nodes().end());
   for (double t : {1.0, 5.0, 17.5}) {
-    scene.update(t);
+    animate(scene, cars, t);
     bvh.refit(scene);
     expect_valid(bvh, scene);
   }
@@ -126,10 +128,8 @@ TEST(Bvh, DynamicObjectsGetASubtreeOfTheirOwn) {
   const MaterialId mat = scene.add_material({});
   for (const Aabb& b : random_boxes(50, 6))
     scene.add_object(scene.add_mesh(test::box_mesh(b)), mat, glm::mat4(1), OccluderClass::always);
-  Motion m;
-  m.waypoints = {{0, 0, 0}, {10, 0, 0}};
   for (int i = 0; i < 5; ++i)
-    scene.add_dynamic_object(scene.add_mesh(test::box_mesh({{0, 0, 0}, {1, 1, 1}})), mat, m,
+    scene.add_dynamic_object(scene.add_mesh(test::box_mesh({{0, 0, 0}, {1, 1, 1}})), mat, glm::mat4(1.0f),
                              OccluderClass::never);
   const Bvh bvh = Bvh::build(scene);
   const NodeId dyn = bvh.right(Bvh::root());

@@ -1,6 +1,7 @@
 // Query ownership: a culler hands back every query it holds (Culler::release)
 // and keeps no backend between frames; the test backend enforces the query
 // contract of occull/backend.hpp.
+#include "occull/motion.hpp"
 #include "occull/culler.hpp"
 #include "occull/error.hpp"
 #include "occull/profile_io.hpp"
@@ -19,8 +20,9 @@ using namespace occull;
 
 namespace {
 
-// 80 boxes in front of the camera, 8 of them moving across the others.
-Scene moving_boxes() {
+// 80 boxes in front of the camera, 8 of them moving across the others
+// (on `scripted`).
+Scene moving_boxes(std::vector<ScriptedObject>& scripted) {
   std::vector<Aabb> boxes;
   for (int i = 0; i < 80; ++i) {
     const float x = float((i * 37) % 21) - 10.0f, y = float((i * 11) % 13) - 6.0f;
@@ -33,7 +35,7 @@ Scene moving_boxes() {
     Motion m;
     m.waypoints = {{-12.0f, float(i) - 4.0f, -10.0f - 4.0f * float(i)}, {12.0f, float(i) - 4.0f, -12.0f - 4.0f * float(i)}};
     m.speed = 3.0f + float(i);
-    scene.add_dynamic_object(cube, 0, m, OccluderClass::sometimes);
+    add_scripted_object(scene, scripted, cube, 0, m, OccluderClass::sometimes);
   }
   return scene;
 }
@@ -79,7 +81,8 @@ TEST(ScriptedBackend, AQueryOfAnotherDeviceFailsLoudly) {
 // moving objects and late, changing answers: what it says it holds is what
 // the backend has in flight, and after release() nothing is.
 TEST(QueryOwnership, EveryBvhAlgorithmHandsBackEveryQuery) {
-  Scene scene = moving_boxes();
+  std::vector<ScriptedObject> scripted;
+  Scene scene = moving_boxes(scripted);
   Bvh bvh = Bvh::build(scene);
   Options base;
   const test::ProfileFile profile("occull-ownership-" + std::to_string(::getpid()) + ".json");
@@ -97,7 +100,7 @@ TEST(QueryOwnership, EveryBvhAlgorithmHandsBackEveryQuery) {
     int frame = 0;
     make_slow_and_changing(backend, frame);
     for (frame = 0; frame < 24; ++frame) {
-      scene.update(frame / 30.0);
+      animate(scene, scripted, frame / 30.0);
       bvh.refit(scene);
       (void)culler->render_frame(view, backend);
       EXPECT_EQ(culler->queries_held(), backend.in_flight()) << info.name << " frame " << frame;

@@ -332,10 +332,8 @@ TEST_F(RendererTest, TranslucentObjectsNeitherOccludeNorWriteIds) {
 TEST_F(RendererTest, DynamicObjectsAreDrawnWhereTheyAreNow) {
   Scene scene("moving");
   const MaterialId grey = scene.add_material({"grey", {0.6f, 0.6f, 0.6f, 1.0f}, false, 0});
-  Motion m;
-  m.waypoints = {{-30, 0, -20}, {30, 0, -20}};
-  m.speed = 1.0f;
-  scene.add_dynamic_object(scene.add_mesh(test::box_mesh({{-1, -1, -1}, {1, 1, 1}})), grey, m,
+  const auto at = [](float x) { return glm::translate(glm::mat4(1.0f), {x, 0.0f, -20.0f}); };
+  scene.add_dynamic_object(scene.add_mesh(test::box_mesh({{-1, -1, -1}, {1, 1, 1}})), grey, at(-30.0f),
                            OccluderClass::never);
   const View view = make_view({{0, 0, 0}, 0, 0}, {60.0f, 0.1f, 100.0f}, kSize, kSize);
   for (const bool multi : {false, true}) {  // matrices as uniforms, and from the object buffer
@@ -343,12 +341,12 @@ TEST_F(RendererTest, DynamicObjectsAreDrawnWhereTheyAreNow) {
     o.draw = multi ? gl::DrawMode::multi : gl::DrawMode::single;
     gl::Renderer r(scene, o);
     const ObjectId obj[] = {0};
-    scene.update(0.0);  // far left: outside the view
+    scene.set_transform(0, at(-30.0f));  // far left: outside the view
     r.begin_frame(view);
     r.render(obj);
     r.end_frame();
     EXPECT_TRUE(ids_in(r.read_ids()).empty()) << "multi " << multi;
-    scene.update(30.0);  // straight ahead
+    scene.set_transform(0, at(0.0f));  // straight ahead
     r.begin_frame(view);
     r.render(obj);
     r.end_frame();

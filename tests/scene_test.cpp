@@ -1,5 +1,6 @@
 #include "occull/error.hpp"
 #include "occull/scene.hpp"
+#include "occull/motion.hpp"
 #include "test_util.hpp"
 
 #include <algorithm>
@@ -55,20 +56,46 @@ TEST(Motion, ObjectFacesItsDirectionOfTravel) {
   EXPECT_NEAR(forward.z, 1.0f, 1e-5f);
 }
 
-TEST(Scene, UpdateMovesDynamicObjectsAndTheirBounds) {
+TEST(Motion, AnimateMovesScriptedObjectsAndTheirBounds) {
   Scene s("t");
   const MeshId mesh = s.add_mesh(unit_quad_mesh());
   const MaterialId mat = s.add_material({});
   Motion m;
   m.waypoints = {{0, 0, 0}, {100, 0, 0}};
   m.speed = 10.0f;
-  const ObjectId id = s.add_dynamic_object(mesh, mat, m, OccluderClass::never);
+  std::vector<ScriptedObject> scripted;
+  const ObjectId id = add_scripted_object(s, scripted, mesh, mat, m, OccluderClass::never);
   ASSERT_TRUE(s.object(id).dynamic());
   ASSERT_EQ(s.dynamic_objects().size(), 1u);
-  s.update(2.0);
+  EXPECT_EQ(s.dynamic_range(id), (Aabb{{0, 0, 0}, {100, 0, 0}})) << "where it goes";
+  animate(s, scripted, 2.0);
   EXPECT_NEAR(s.object(id).bounds.min.x, 20.0f, 1e-4f);
-  s.update(0.0);
+  animate(s, scripted, 0.0);
   EXPECT_NEAR(s.object(id).bounds.min.x, 0.0f, 1e-4f);
+  m.speed = 0.0f;
+  EXPECT_THROW((void)add_scripted_object(s, scripted, mesh, mat, m, OccluderClass::never), InputError);
+  EXPECT_EQ(scripted.size(), 1u);
+}
+
+TEST(Scene, ADynamicObjectMovesUnlistedWithinItsRange) {
+  Scene s("t");
+  const MeshId mesh = s.add_mesh(unit_quad_mesh());
+  const MaterialId mat = s.add_material({});
+  const ObjectId still = s.add_object(mesh, mat, glm::mat4(1.0f), OccluderClass::never);
+  const ObjectId car = s.add_dynamic_object(mesh, mat, glm::mat4(1.0f), OccluderClass::never, {{0, 0, 0}, {50, 0, 0}});
+  const std::uint64_t revision = s.placement_revision();
+  s.set_transform(car, glm::translate(glm::mat4(1.0f), {7, 0, 0}));
+  EXPECT_NEAR(s.object(car).bounds.min.x, 7.0f, 1e-5f);
+  EXPECT_EQ(s.placement_revision(), revision) << "consumers follow every dynamic object each frame";
+  s.set_transform(still, glm::translate(glm::mat4(1.0f), {7, 0, 0}));
+  EXPECT_EQ(s.placement_revision(), revision + 1);
+  EXPECT_EQ(s.dynamic_range(car), (Aabb{{0, 0, 0}, {50, 0, 0}}));
+  EXPECT_TRUE(s.dynamic_range(still).empty());
+  s.set_dynamic_range(car, {{10, 0, 0}, {60, 0, 0}});
+  EXPECT_EQ(s.dynamic_range(car), (Aabb{{10, 0, 0}, {60, 0, 0}}));
+  EXPECT_THROW(s.set_dynamic_range(still, {{0, 0, 0}, {1, 1, 1}}), UsageError);
+  EXPECT_THROW(s.set_dynamic_range(car, {{0, 0, 0}, {std::nanf(""), 1, 1}}), InputError);
+  EXPECT_EQ(s.dynamic_range(car), (Aabb{{10, 0, 0}, {60, 0, 0}})) << "unchanged by a refused call";
 }
 
 TEST(Scene, SetTransformMovesAnyObjectAndCountsAPlacement) {
@@ -105,10 +132,12 @@ TEST(Scene, RemovingADynamicObjectStopsItsMotion) {
   const MaterialId mat = s.add_material({});
   Motion m;
   m.waypoints = {{0, 0, 0}, {10, 0, 0}};
-  const ObjectId id = s.add_dynamic_object(mesh, mat, m, OccluderClass::never);
+  std::vector<ScriptedObject> scripted;
+  const ObjectId id = add_scripted_object(s, scripted, mesh, mat, m, OccluderClass::never);
   s.remove_object(id);
-  s.update(1.0);
+  animate(s, scripted, 1.0);
   EXPECT_TRUE(s.object(id).bounds.empty());
+  EXPECT_TRUE(s.dynamic_range(id).empty());
   EXPECT_TRUE(s.dynamic_objects().empty());
 }
 

@@ -53,8 +53,8 @@ TEST(Scenes, SeedChangesTheScene) {
 TEST(Scenes, DynamicObjectsMoveDeterministically) {
   SceneBundle a = make_scene("city:blocks=3,traffic=5");
   SceneBundle b = make_scene("city:blocks=3,traffic=5");
-  a.scene.update(3.25);
-  b.scene.update(3.25);
+  animate(a.scene, a.scripted, 3.25);
+  animate(b.scene, b.scripted, 3.25);
   ASSERT_EQ(a.scene.dynamic_objects().size(), 5u);
   for (ObjectId id : a.scene.dynamic_objects())
     EXPECT_EQ(a.scene.object(id).bounds, b.scene.object(id).bounds);

@@ -76,7 +76,7 @@ int cmd_raster(const RasterArgs& a) {
     std::vector<Job> jobs;
     for (int k = 0; k < a.frames; ++k) {
       const double t = path.frame_time(k, a.frames);
-      scene.update(t);
+      animate(scene, bundle.scripted, t);
       const View view = make_view(path.sample(t), bundle.lens, w, h);
       jobs.clear();
       for (const Object& o : scene.objects()) {

@@ -60,8 +60,8 @@ class Bvh {
   /// of a tile whose objects occupy consecutive ids from `first_object`.
   [[nodiscard]] Bvh instance(const glm::vec3& offset, ObjectId first_object) const;
 
-  /// Follows the scene after the frame's changes (Scene::update, and an
-  /// engine's set_transform, add_object, remove_object), before the cullers
+  /// Follows the scene after the frame's changes (an engine's
+  /// set_transform of any object, add_object, remove_object), before the cullers
   /// run. Refits the dynamic subtree and the ancestors of every object the
   /// engine changed (Scene::for_each_changed_since), so no node's box is
   /// stale. Rebuilds the whole hierarchy (generation() changes) when objects

@@ -29,7 +29,7 @@ class DrawRecorder;
 
 /// What a culler reads: the scene and its hierarchy, shared read-only by
 /// every culler instance. Both must outlive the cullers made from them; the
-/// owner changes the scene (Scene::update, set_transform, add_object,
+/// owner changes the scene (set_transform, add_object,
 /// remove_object) and calls Bvh::refit between frames, and the cullers
 /// follow: per-object state grows with the scene, per-node state is carried
 /// over when the hierarchy is rebuilt (Bvh::generation).

@@ -1,9 +1,10 @@
-// occull — the scene model: meshes, materials, objects and their motion.
+// occull — the scene model: meshes, materials and objects.
 //
 // A Scene owns everything the renderer draws and the cullers reason about.
 // Objects reference meshes and materials by index; several objects may share
-// one mesh (instancing). Dynamic objects follow a looped Motion and are moved
-// by Scene::update(); everything else never moves.
+// one mesh (instancing). The engine moves objects with set_transform();
+// dynamic objects (add_dynamic_object) are those it moves from frame to
+// frame, which the hierarchy keeps apart.
 #pragma once
 
 #include "occull/geometry.hpp"
@@ -56,17 +57,6 @@ struct Material {
 /// small details `never`.
 enum class OccluderClass : std::uint8_t { always, sometimes, never };
 
-/// A closed polyline followed at constant speed, looping forever. The object
-/// faces along its direction of travel (its mesh's +X axis turned about +Y).
-struct Motion {
-  std::vector<glm::vec3> waypoints;  ///< >= 2 points; the last joins the first
-  float speed = 1.0f;                ///< scene units per second, > 0
-  float start_offset = 0.0f;         ///< distance along the loop at time 0
-
-  /// World transform at `time_s` seconds.
-  [[nodiscard]] glm::mat4 transform_at(double time_s) const;
-};
-
 struct Object {
   MeshId mesh = 0;
   MaterialId material = 0;
@@ -74,10 +64,10 @@ struct Object {
   Aabb bounds;                   ///< world-space box of the transformed mesh
   std::uint32_t triangles = 0;   ///< triangle count of the mesh
   OccluderClass occluder = OccluderClass::sometimes;
-  std::int32_t motion = -1;      ///< index into Scene::motions(), -1 for static objects
+  bool moving = false;           ///< a dynamic object (Scene::add_dynamic_object)
   bool removed = false;          ///< removed by Scene::remove_object: empty bounds, no triangles
 
-  [[nodiscard]] bool dynamic() const noexcept { return motion >= 0; }
+  [[nodiscard]] bool dynamic() const noexcept { return moving; }
 };
 
 /// The most a Scene holds; past it add_object / add_mesh throw InputError.
@@ -87,7 +77,7 @@ struct SceneLimits {
   std::uint64_t mesh_triangles = limits::mesh_triangles;  ///< each mesh counted once
 };
 
-/// A scene: the meshes, materials, objects and motions of one world.
+/// A scene: the meshes, materials and objects of one world.
 /// Invariant: every object's `bounds` and `triangles` match its mesh and
 /// transform (every call that changes an object maintains it).
 ///
@@ -116,8 +106,9 @@ class Scene {
   ObjectId add_object(MeshId mesh, MaterialId material, const glm::mat4& transform,
                       OccluderClass occluder);
   /// Sets object `id`'s object-to-world transform; its bounds follow. Any
-  /// object, static or dynamic (a dynamic one's next update() puts it back
-  /// on its Motion). Throws, the scene unchanged, UsageError for an id that
+  /// object, static or dynamic (a dynamic object's moves are not recorded in
+  /// moved_objects() nor counted by placement_revision(): every consumer
+  /// follows the dynamic objects each frame). Throws, the scene unchanged, UsageError for an id that
   /// does not exist or was removed, InputError for a transform with an entry
   /// that is not finite.
   void set_transform(ObjectId id, const glm::mat4& transform);
@@ -132,8 +123,9 @@ class Scene {
   /// per-object state sized or listed by the set of objects is stale when it
   /// changed.
   [[nodiscard]] std::uint64_t layout_revision() const noexcept { return layout_revision_; }
-  /// Counts every change of an object's transform or placement other than
-  /// update()'s: set_transform, place_object, add_object, remove_object.
+  /// Counts every change of an object's transform or placement other than a
+  /// dynamic object's moves: set_transform, place_object, add_object,
+  /// remove_object.
   [[nodiscard]] std::uint64_t placement_revision() const noexcept { return placement_revision_; }
   /// Calls `f(id)` for every object changed (placed, moved, added, removed)
   /// since placement revision `since`: from the list of moved objects when
@@ -150,19 +142,22 @@ class Scene {
     }
     return placement_revision_;
   }
-  /// Adds a dynamic object that follows `motion` (its transform at time 0 is
-  /// applied at once). `local` is applied before the motion's transform.
-  /// Throws as add_object(), and InputError for a motion without 2 finite
-  /// waypoints and a finite speed > 0.
-  ObjectId add_dynamic_object(MeshId mesh, MaterialId material, Motion motion,
-                              OccluderClass occluder, const glm::mat4& local = glm::mat4(1.0f));
-
-  /// Replaces motion `index` of motions(): the dynamic objects on it follow
-  /// the new one from their next update() (an engine that re-routes them, or
-  /// moves its floating origin). Throws, the scene unchanged, UsageError for
-  /// an index out of range, InputError for a motion without 2 finite
-  /// waypoints and a finite speed > 0.
-  void set_motion(std::size_t index, Motion motion);
+  /// Adds a dynamic object: one the engine moves (set_transform) from frame
+  /// to frame, a car or a door. The hierarchy keeps dynamic objects apart
+  /// (Bvh), and every consumer follows all of them each frame. `range`: the
+  /// world box the object's position (its transform's translation) stays
+  /// within, where known (empty: unknown), so that structures sized once
+  /// (the grid of `grid`) reach where it goes. Throws as add_object(), and
+  /// InputError for a range that is not finite.
+  ObjectId add_dynamic_object(MeshId mesh, MaterialId material, const glm::mat4& transform,
+                              OccluderClass occluder, const Aabb& range = {});
+  /// Where dynamic object `id`'s position stays (add_dynamic_object); empty
+  /// when unknown, and for other objects.
+  [[nodiscard]] Aabb dynamic_range(ObjectId id) const;
+  /// Sets it (an engine that re-routes the object, or moves its floating
+  /// origin). Throws UsageError unless `id` is a dynamic object, InputError
+  /// for a range that is not finite.
+  void set_dynamic_range(ObjectId id, const Aabb& range);
 
   /// Makes static object `id` another object in place: its mesh, material,
   /// transform and class (a tiled world reuses the ids of a tile that left
@@ -181,9 +176,6 @@ class Scene {
     moved_.clear();
     moved_from_revision_ = placement_revision_;
   }
-  /// Moves every dynamic object to where it is at `time_s` and updates its
-  /// bounds. Deterministic: the same time gives the same transforms.
-  void update(double time_s);
 
   [[nodiscard]] const std::string& name() const noexcept { return name_; }
   [[nodiscard]] std::span<const Mesh> meshes() const noexcept { return meshes_; }
@@ -192,7 +184,6 @@ class Scene {
   [[nodiscard]] const Object& object(ObjectId id) const { return objects_[id]; }
   [[nodiscard]] const Mesh& mesh(MeshId id) const { return meshes_[id]; }
   [[nodiscard]] const Material& material(MaterialId id) const { return materials_[id]; }
-  [[nodiscard]] std::span<const Motion> motions() const noexcept { return motions_; }
   /// Ids of the dynamic objects, ascending.
   [[nodiscard]] std::span<const ObjectId> dynamic_objects() const noexcept { return dynamic_; }
   /// Sum of the objects' triangle counts (instances counted each time).
@@ -209,9 +200,8 @@ class Scene {
   std::vector<Mesh> meshes_;
   std::vector<Material> materials_;
   std::vector<Object> objects_;
-  std::vector<Motion> motions_;
-  std::vector<glm::mat4> dynamic_local_;  // per motion: local transform
   std::vector<ObjectId> dynamic_;
+  std::vector<Aabb> dynamic_range_;  // per object id (grown on demand): empty for static ones
   std::vector<ObjectId> moved_;
   std::vector<ObjectId> free_ids_;  // removed objects' ids, the most recent last
   std::uint64_t layout_revision_ = 0;
@@ -219,9 +209,9 @@ class Scene {
   std::uint64_t moved_from_revision_ = 0;  // moved_ lists every change after this revision
   // Records a change of object `id`'s placement.
   void note_moved(ObjectId id);
-  // Throw UsageError for an object that is not there, InputError for a motion that is not finite.
+  // Throw UsageError for an object that is not there, InputError for a range that is not finite.
   void check_object(ObjectId id, const char* what) const;
-  void check_motion(const Motion& motion, const char* what) const;
+  void check_range(const Aabb& range, const char* what) const;
   // A static object of `mesh` at `transform`, its bounds and triangles filled.
   [[nodiscard]] Object make_object(MeshId mesh, MaterialId material, const glm::mat4& transform,
                                    OccluderClass occluder) const;

@@ -4,6 +4,7 @@
 // seed): the same spec gives the same scene, byte for byte.
 #pragma once
 
+#include "occull/motion.hpp"
 #include "occull/scene.hpp"
 #include "occull/tiles.hpp"
 #include <memory>
@@ -49,6 +50,9 @@ struct SceneBundle {
   /// objects, and the owner calls world->follow(scene, eye) before each
   /// frame it renders (occull/tiles.hpp).
   std::shared_ptr<TiledWorld> world;
+  /// The dynamic objects on their scripted motions (the city's traffic):
+  /// animate(scene, scripted, t) moves them to time t.
+  std::vector<ScriptedObject> scripted;
 
   /// The named path. Throws InputError listing the valid names.
   [[nodiscard]] const CameraPath& path(std::string_view name) const;

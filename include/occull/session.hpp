@@ -322,7 +322,7 @@ class Session {
   /// Objects moved by the engine, for benchmarks (--engine-moves): from now
   /// on, before every frame and its truth, `fraction` of the static objects
   /// (every round(1 / fraction)-th; 0: none) are moved with
-  /// Scene::set_transform, not a Motion, around small circles (2 scene units
+  /// Scene::set_transform, as static objects (not scripted dynamic ones), around small circles (2 scene units
   /// across, one turn in 4 s of path time) about where they stood, as an
   /// engine's game logic would; the hierarchy follows in run_frame().
   /// Throws InputError for a fraction outside [0, 1] or on a tiled world.
@@ -391,7 +391,7 @@ class Session {
   double origin_grid_ = kOriginGrid;
   std::uint64_t origin_moves_ = 0;
   std::vector<glm::mat4> home_;
-  std::vector<Motion> home_motions_;
+  std::vector<ScriptedObject> home_scripted_;
   // `home` (a transform or a point relative to bundle_.origin) relative to origin_, in double.
   [[nodiscard]] glm::mat4 placed(const glm::mat4& home) const;
   [[nodiscard]] glm::vec3 placed(const glm::vec3& home) const;

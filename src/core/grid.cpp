@@ -50,12 +50,10 @@ UniformGrid UniformGrid::of_scene(const Scene& scene, float cell_size) {
     throw InputError(detail::format("grid cell size {}: must be a positive number of scene units (0: default)", cell_size));
   if (cell_size == 0.0f) cell_size = default_cell_size(scene);
   Aabb bounds = scene.bounds();
-  // Where dynamic objects go: their loops, grown by their size.
+  // Where dynamic objects go: their ranges, grown by their size.
   for (ObjectId id : scene.dynamic_objects()) {
-    const Object& o = scene.object(id);
-    const Motion& m = scene.motions()[std::size_t(o.motion)];
-    const float reach = glm::length(o.bounds.extent());
-    for (const glm::vec3& p : m.waypoints) bounds.extend(Aabb{p, p}.grown(reach));
+    const Aabb range = scene.dynamic_range(id);
+    if (!range.empty()) bounds.extend(range.grown(glm::length(scene.object(id).bounds.extent())));
   }
   GridGeometry g;
   g.cell = glm::vec3(cell_size);

@@ -29,30 +29,6 @@ double Mesh::surface_area() const noexcept {
   return area;
 }
 
-glm::mat4 Motion::transform_at(double time_s) const {
-  assert(waypoints.size() >= 2 && speed > 0.0f);
-  const std::size_t n = waypoints.size();
-  double loop = 0.0;
-  for (std::size_t i = 0; i < n; ++i) loop += glm::length(waypoints[(i + 1) % n] - waypoints[i]);
-  if (loop <= 0.0) return glm::translate(glm::mat4(1.0f), waypoints.front());
-  double s = std::fmod(start_offset + speed * time_s, loop);
-  if (s < 0.0) s += loop;
-  for (std::size_t i = 0; i < n; ++i) {
-    const glm::vec3 a = waypoints[i];
-    const glm::vec3 b = waypoints[(i + 1) % n];
-    const double len = glm::length(b - a);
-    if (s <= len || i + 1 == n) {
-      const float f = len > 0.0 ? float(std::min(s / len, 1.0)) : 0.0f;
-      const glm::vec3 p = a + (b - a) * f;
-      const glm::vec3 dir = b - a;
-      const float yaw = std::atan2(-dir.z, dir.x);  // +X turned about +Y
-      return glm::rotate(glm::translate(glm::mat4(1.0f), p), yaw, glm::vec3(0, 1, 0));
-    }
-    s -= len;
-  }
-  return glm::translate(glm::mat4(1.0f), waypoints.front());
-}
-
 MeshId Scene::add_mesh(Mesh mesh) {
   if (mesh.normals.size() != mesh.positions.size() || mesh.indices.size() % 3 != 0)
     throw UsageError(detail::format("scene {}: add_mesh: {} normals for {} positions and {} indices (one normal per "
@@ -154,14 +130,17 @@ void Scene::set_transform(ObjectId id, const glm::mat4& transform) {
   Object& o = objects_[id];
   o.transform = transform;
   o.bounds = transform_box(mesh_bounds_[o.mesh], transform);
-  note_moved(id);
+  if (!o.moving) note_moved(id);  // consumers follow every dynamic object each frame
 }
 
 void Scene::remove_object(ObjectId id) {
   check_object(id, "remove_object of");
   Object& o = objects_[id];
-  if (o.dynamic()) std::erase(dynamic_, id);  // its Motion stays in motions(), unused
-  o.motion = -1;
+  if (o.moving) {
+    std::erase(dynamic_, id);
+    dynamic_range_[id] = Aabb{};
+  }
+  o.moving = false;
   o.removed = true;
   o.bounds = Aabb{};
   o.triangles = 0;
@@ -182,40 +161,40 @@ Object Scene::make_object(MeshId mesh, MaterialId material, const glm::mat4& tra
   return o;
 }
 
-ObjectId Scene::add_dynamic_object(MeshId mesh, MaterialId material, Motion motion,
-                                   OccluderClass occluder, const glm::mat4& local) {
-  check_motion(motion, "add_dynamic_object");
-  const glm::mat4 start = motion.transform_at(0.0) * local;
-  const ObjectId id = add_object(mesh, material, start, occluder);
-  motions_.push_back(std::move(motion));
-  dynamic_local_.push_back(local);
-  objects_[id].motion = std::int32_t(motions_.size() - 1);
+ObjectId Scene::add_dynamic_object(MeshId mesh, MaterialId material, const glm::mat4& transform,
+                                   OccluderClass occluder, const Aabb& range) {
+  check_range(range, "add_dynamic_object");
+  const ObjectId id = add_object(mesh, material, transform, occluder);
+  objects_[id].moving = true;
   dynamic_.insert(std::upper_bound(dynamic_.begin(), dynamic_.end(), id), id);  // ascending, ids may be reused
+  if (dynamic_range_.size() <= id) dynamic_range_.resize(std::size_t(id) + 1);
+  dynamic_range_[id] = range;
   return id;
 }
 
-void Scene::check_motion(const Motion& motion, const char* what) const {
-  const bool finite_points = std::all_of(motion.waypoints.begin(), motion.waypoints.end(), [](const glm::vec3& p) {
-    return std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z);
-  });
-  if (motion.waypoints.size() < 2 || !finite_points || !std::isfinite(motion.speed) || motion.speed <= 0.0f ||
-      !std::isfinite(motion.start_offset))
-    throw InputError(detail::format("scene {}: {}: a motion needs 2 or more finite waypoints and a finite speed > 0",
-                                    name_, what));
+void Scene::check_range(const Aabb& range, const char* what) const {
+  const auto finite3 = [](const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); };
+  if (!range.empty() && !(finite3(range.min) && finite3(range.max)))
+    throw InputError(detail::format("scene {}: {}: a dynamic object's range must be finite", name_, what));
 }
 
-void Scene::set_motion(std::size_t index, Motion motion) {
-  if (index >= motions_.size())
-    throw UsageError(detail::format("scene {}: set_motion of motion {}: the scene has {}", name_, index, motions_.size()));
-  check_motion(motion, "set_motion");
-  motions_[index] = std::move(motion);
+Aabb Scene::dynamic_range(ObjectId id) const {
+  return id < dynamic_range_.size() && alive(id) && objects_[id].moving ? dynamic_range_[id] : Aabb{};
+}
+
+void Scene::set_dynamic_range(ObjectId id, const Aabb& range) {
+  check_object(id, "set_dynamic_range of");
+  if (!objects_[id].moving)
+    throw UsageError(detail::format("scene {}: set_dynamic_range of object {}: it is not dynamic", name_, id));
+  check_range(range, "set_dynamic_range");
+  dynamic_range_[id] = range;
 }
 
 void Scene::place_object(ObjectId id, MeshId mesh, MaterialId material, const glm::mat4& transform,
                          OccluderClass occluder) {
   check_object(id, "place_object");
   if (objects_[id].dynamic())
-    throw UsageError(detail::format("scene {}: place_object of object {}: it is dynamic (it follows its motion)",
+    throw UsageError(detail::format("scene {}: place_object of object {}: it is dynamic (moved from frame to frame)",
                                     name_, id));
   if (mesh >= meshes_.size() || material >= materials_.size())
     throw UsageError(detail::format("scene {}: place_object: mesh {} or material {} does not exist ({} meshes, {} "
@@ -223,14 +202,6 @@ void Scene::place_object(ObjectId id, MeshId mesh, MaterialId material, const gl
                                     name_, mesh, material, meshes_.size(), materials_.size()));
   objects_[id] = make_object(mesh, material, transform, occluder);
   note_moved(id);
-}
-
-void Scene::update(double time_s) {
-  for (ObjectId id : dynamic_) {
-    Object& o = objects_[id];
-    o.transform = motions_[o.motion].transform_at(time_s) * dynamic_local_[o.motion];
-    o.bounds = transform_box(mesh_bounds_[o.mesh], o.transform);
-  }
 }
 
 std::uint64_t Scene::triangle_count() const noexcept {

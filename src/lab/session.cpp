@@ -60,7 +60,7 @@ void Session::start(const gl::RendererOptions& renderer_options, const BvhOption
   // then snaps to its cell (a scene far out is re-placed near it at once).
   origin_ = bundle_.origin;
   for (const Object& o : bundle_.scene.objects()) home_.push_back(o.transform);
-  home_motions_.assign(bundle_.scene.motions().begin(), bundle_.scene.motions().end());
+  home_scripted_ = bundle_.scripted;
   if (!bundle_.world) move_origin(origin_cell(bundle_.origin, origin_grid_));
   // A tiled world has no global hierarchy: its cullers keep one BVH
   // instance per tile (occull/tiles.hpp).
@@ -176,10 +176,11 @@ void Session::move_origin(const glm::dvec3& origin) {
   Scene& scene = bundle_.scene;
   for (ObjectId id = 0; id < home_.size(); ++id)
     if (scene.alive(id) && !scene.object(id).dynamic()) scene.set_transform(id, placed(home_[id]));
-  for (std::size_t i = 0; i < home_motions_.size(); ++i) {
-    Motion m = home_motions_[i];
-    for (glm::vec3& p : m.waypoints) p = placed(p);
-    scene.set_motion(i, std::move(m));
+  for (std::size_t i = 0; i < home_scripted_.size(); ++i) {
+    ScriptedObject& s = bundle_.scripted[i];
+    s.motion = home_scripted_[i].motion;
+    for (glm::vec3& p : s.motion.waypoints) p = placed(p);
+    if (scene.alive(s.id) && scene.object(s.id).dynamic()) scene.set_dynamic_range(s.id, s.motion.range());
   }
 }
 
@@ -240,7 +241,7 @@ void Session::set_engine_moves(double fraction) {
 }
 
 void Session::advance_scene(double time_s) {
-  bundle_.scene.update(time_s);
+  animate(bundle_.scene, bundle_.scripted, time_s);
   for (std::size_t i = 0; i < engine_moved_.size(); ++i) {
     const double angle = time_s * (2.0 * 3.14159265358979 / 4.0) + 0.7 * double(i);
     const glm::vec3 offset(float(std::cos(angle)), 0.0f, float(std::sin(angle)));

@@ -323,7 +323,7 @@ BenchResult run_osg_bench(const OsgBenchConfig& config, const ProgressFn& progre
         const int k = warm ? (config.warmup > 1 ? step * (config.frames - 1) / (config.warmup - 1) : 0)
                            : step - config.warmup;
         const double t = session.frame_time(path, k, config.frames);
-        scene.update(t);
+        animate(scene, session.bundle().scripted, t);
         update_exported(scene, graph.exported);
         kept.clear();
         const double frame_ms = device->frame(session.view_at(path, k, config.frames), t);

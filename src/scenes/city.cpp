@@ -39,7 +39,8 @@ struct CityParams {
 
 class CityBuilder {
  public:
-  CityBuilder(const CityParams& p, Scene& scene) : p_(p), scene_(scene), rng_(p.seed) {
+  CityBuilder(const CityParams& p, SceneBundle& bundle)
+      : p_(p), scene_(bundle.scene), scripted_(bundle.scripted), rng_(p.seed) {
     origin_ = -0.5f * (float(p.blocks) * kPitch + kStreet);
   }
 
@@ -321,14 +322,17 @@ class CityBuilder {
                           {b.max.x, 0.0f, b.max.z}, {b.max.x, 0.0f, b.min.z}};
       motion.speed = rng_.uniform(6.0f, 12.0f);
       motion.start_offset = rng_.uniform(0.0f, 4.0f * (kBlock + 8.0f));
-      scene_.add_dynamic_object(car_meshes_[std::size_t(rng_.integer(0, 1))],
-                                cars_[std::size_t(rng_.integer(0, int(cars_.size()) - 1))],
-                                std::move(motion), OccluderClass::sometimes);
+      // The paint drawn before the mesh: the order in which GCC evaluated the
+      // arguments of the call these came from, so the traffic stays as it was.
+      const MaterialId paint = cars_[std::size_t(rng_.integer(0, int(cars_.size()) - 1))];
+      const MeshId car = car_meshes_[std::size_t(rng_.integer(0, 1))];
+      add_scripted_object(scene_, scripted_, car, paint, std::move(motion), OccluderClass::sometimes);
     }
   }
 
   CityParams p_;
   Scene& scene_;
+  std::vector<ScriptedObject>& scripted_;
   Rng rng_;
   float origin_ = 0.0f;
   float tallest_ = 0.0f;
@@ -422,7 +426,7 @@ SceneBundle make_city(const Params& params) {
   p.shading = int(params.at("shading"));
   p.seed = std::uint64_t(params.at("seed"));
   SceneBundle bundle{Scene("city"), {}, Lens{60.0f, 0.1f, 1500.0f}};
-  CityBuilder builder(p, bundle.scene);
+  CityBuilder builder(p, bundle);
   builder.build();
   bundle.paths = city_paths(builder, p.blocks);
   bundle.lens.far = std::max(1500.0f, 1.5f * float(p.blocks) * kPitch);

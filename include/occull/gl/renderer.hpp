@@ -123,7 +123,7 @@ struct RendererOptions {
 ///
 /// Preconditions: a gl::Context is current on the calling thread for the
 /// renderer's whole life; `scene` outlives the renderer and keeps its
-/// meshes. Objects may move (update(), set_transform, place_object), be
+/// meshes. Objects may move (set_transform, place_object), be
 /// removed and have their ids reused; objects added past the count the scene
 /// had when the renderer was made, and meshes added after it, are refused
 /// (UsageError at the next frame: make a new renderer). Query calls

@@ -34,7 +34,7 @@ struct ExportedScene {
 [[nodiscard]] ExportedScene export_scene(const occull::Scene& scene);
 
 /// Moves the exported objects to where `scene`'s objects are now (after
-/// occull::Scene::update moved the dynamic ones, or an engine's set_transform).
+/// an animate() of the scripted ones, or an engine's set_transform).
 void update_exported(const occull::Scene& scene, ExportedScene& exported);
 
 /// A graph read from a file (`occull osg --file`) as an occull scene.
