@@ -1,5 +1,6 @@
 // The run-time invariants of the instrument, each broken on purpose through
 // a fault hook: a check that has never been seen failing is not trusted.
+#include "lab/fault_hooks.hpp"
 #include "lab/invariants.hpp"
 #include "gl_test_util.hpp"
 #include "occull/error.hpp"
@@ -15,6 +16,12 @@ using namespace occull;
 namespace {
 
 constexpr const char* kScene = "city:blocks=3,traffic=6";
+
+// The run's fault hooks, made on first use.
+detail::FaultHooks& hooks(BenchConfig& c) {
+  if (!c.hooks) c.hooks = std::make_shared<detail::FaultHooks>();
+  return *c.hooks;
+}
 
 BenchConfig small_bench(std::vector<std::string> algorithms) {
   BenchConfig c;
@@ -56,8 +63,8 @@ TEST(Invariants, HoldOnAnUnbrokenRun) {
 TEST(Invariants, TruthWithAnObjectOutsideTheFrustumStopsTheRun) {
   BenchConfig c = small_bench({"vfc"});
   auto drawn = std::make_shared<std::vector<ObjectId>>();
-  c.hooks.truth_objects = [drawn](std::vector<ObjectId>& objects) { *drawn = objects; };
-  c.hooks.truth_images = [drawn](std::vector<gl::Renderer::ObjectPixels>& visible, gl::Renderer::PassImages&) {
+  hooks(c).truth_objects = [drawn](std::vector<ObjectId>& objects) { *drawn = objects; };
+  hooks(c).truth_images = [drawn](std::vector<gl::Renderer::ObjectPixels>& visible, gl::Renderer::PassImages&) {
     ObjectId outside = 0;
     while (std::find(drawn->begin(), drawn->end(), outside) != drawn->end()) ++outside;
     visible.push_back({outside, 3});
@@ -68,7 +75,7 @@ TEST(Invariants, TruthWithAnObjectOutsideTheFrustumStopsTheRun) {
 
 TEST(Invariants, IdImageThatDisagreesWithTheDepthImageStopsTheRun) {
   BenchConfig c = small_bench({"vfc"});
-  c.hooks.truth_images = [](std::vector<gl::Renderer::ObjectPixels>&, gl::Renderer::PassImages& images) {
+  hooks(c).truth_images = [](std::vector<gl::Renderer::ObjectPixels>&, gl::Renderer::PassImages& images) {
     const auto covered = std::find_if(images.ids.begin(), images.ids.end(), [](std::uint32_t v) { return v != 0; });
     ASSERT_NE(covered, images.ids.end());
     *covered = 0;  // an id write lost
@@ -79,13 +86,13 @@ TEST(Invariants, IdImageThatDisagreesWithTheDepthImageStopsTheRun) {
 TEST(Invariants, ObjectLeftOutOfTheTruthPassStopsTheRun) {
   // As a frustum test that wrongly calls everything outside would.
   BenchConfig c = small_bench({"vfc"});
-  c.hooks.truth_objects = [](std::vector<ObjectId>& objects) { objects.clear(); };
+  hooks(c).truth_objects = [](std::vector<ObjectId>& objects) { objects.clear(); };
   expect_violation(violation_of(c), "truth-covers-full-render");
 }
 
 TEST(Invariants, EmptyTruthOfACoveredFrameStopsTheRun) {
   BenchConfig c = small_bench({"vfc"});
-  c.hooks.truth_images = [](std::vector<gl::Renderer::ObjectPixels>& visible, gl::Renderer::PassImages&) {
+  hooks(c).truth_images = [](std::vector<gl::Renderer::ObjectPixels>& visible, gl::Renderer::PassImages&) {
     visible.clear();
   };
   expect_violation(violation_of(c), "truth-not-empty");
@@ -95,7 +102,7 @@ TEST(Invariants, TruthPassThatDrewNothingIsCaughtByTheCpuProbe) {
   // The original failure: every draw of the truth pass landed nowhere, so
   // the images are empty and consistent with each other and with the list.
   BenchConfig c = small_bench({"vfc"});
-  c.hooks.truth_images = [](std::vector<gl::Renderer::ObjectPixels>& visible, gl::Renderer::PassImages& images) {
+  hooks(c).truth_images = [](std::vector<gl::Renderer::ObjectPixels>& visible, gl::Renderer::PassImages& images) {
     visible.clear();
     std::fill(images.ids.begin(), images.ids.end(), 0u);
     std::fill(images.depth.begin(), images.depth.end(), 1.0f);
@@ -105,7 +112,7 @@ TEST(Invariants, TruthPassThatDrewNothingIsCaughtByTheCpuProbe) {
 
 TEST(Invariants, FrameCoveringMoreThanTheTruthStopsTheRun) {
   BenchConfig c = small_bench({"vfc"});
-  c.hooks.frame_depth = [](std::vector<float>& depth) { std::fill(depth.begin(), depth.end(), 0.5f); };
+  hooks(c).frame_depth = [](std::vector<float>& depth) { std::fill(depth.begin(), depth.end(), 0.5f); };
   const std::string message = violation_of(c);
   expect_violation(message, "frame-within-truth");
   EXPECT_NE(message.find("vfc covers"), std::string::npos) << message;
@@ -113,7 +120,7 @@ TEST(Invariants, FrameCoveringMoreThanTheTruthStopsTheRun) {
 
 TEST(Invariants, OracleLeavingOutATruthObjectStopsTheRun) {
   BenchConfig c = small_bench({"oracle"});
-  c.hooks.oracle_objects = [](std::vector<ObjectId>& visible) {
+  hooks(c).oracle_objects = [](std::vector<ObjectId>& visible) {
     ASSERT_FALSE(visible.empty());
     visible.pop_back();
   };
@@ -124,7 +131,7 @@ TEST(Invariants, OracleLeavingOutATruthObjectStopsTheRun) {
 
 TEST(Invariants, OracleFrameWithOtherDepthStopsTheRun) {
   BenchConfig c = small_bench({"oracle"});
-  c.hooks.frame_depth = [](std::vector<float>& depth) {
+  hooks(c).frame_depth = [](std::vector<float>& depth) {
     const auto covered = std::find_if(depth.begin(), depth.end(), [](float z) { return z < 1.0f; });
     ASSERT_NE(covered, depth.end());
     *covered = 1.0f;

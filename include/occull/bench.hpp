@@ -43,7 +43,7 @@ struct BenchConfig {
   double stall_guard_ms = 0.0;            ///< > 0: results not there within this time count as visible (StallGuard)
   double watchdog_s = 300.0;              ///< a frame running longer stops the process, exit 1 (Session::set_watchdog; 0: off)
   std::string allocator;                  ///< the process's allocator policy, as the report names it (apply_allocator_policy)
-  FaultHooks hooks;                       ///< tests only: break a step on purpose (see FaultHooks)
+  std::shared_ptr<detail::FaultHooks> hooks;  ///< tests only: break a step on purpose (src/lab/fault_hooks.hpp)
 };
 
 

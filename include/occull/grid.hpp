@@ -69,7 +69,8 @@ class UniformGrid {
 
   /// The grid of a scene with cubic cells of edge `cell_size` (scene units;
   /// 0: default_cell_size(scene)), covering every object and every place a
-  /// dynamic object's motion takes it, with every object inserted.
+  /// dynamic object goes (its Scene::dynamic_range, grown by its size), with
+  /// every object inserted.
   /// Throws InputError when cell_size is negative, or so small that the grid
   /// would exceed 2^20 cells along an axis or list the objects in more than
   /// 2^26 cells in all.

@@ -40,6 +40,7 @@ namespace occull {
 
 namespace detail {
 class Watchdog;    // src/lab/watchdog.hpp
+struct FaultHooks;  // src/lab/fault_hooks.hpp (tests only)
 struct FrameLabel;  // src/lab/invariants.hpp
 }  // namespace detail
 
@@ -148,21 +149,6 @@ class MissRuns {
   std::uint32_t longest_ = 0;
 };
 
-/// Fault injection, for tests only: each hook, when set, may corrupt one
-/// step of the instrument, so a test can see the run-time invariant that
-/// guards that step stop the run (a check never seen failing is not trusted).
-struct FaultHooks {
-  /// The objects the truth pass is about to draw (those inside the frustum).
-  std::function<void(std::vector<ObjectId>& drawn)> truth_objects;
-  /// What the truth pass found and the images it read back.
-  std::function<void(std::vector<gl::Renderer::ObjectPixels>& visible, gl::Renderer::PassImages& images)>
-      truth_images;
-  /// The objects the oracle is told to render.
-  std::function<void(std::vector<ObjectId>& visible)> oracle_objects;
-  /// The depth image of a verified frame of an algorithm, as read back.
-  std::function<void(std::vector<float>& depth)> frame_depth;
-};
-
 /// A scene set up on the GL device: the context, the generated scene with
 /// its paths, its BVH and the renderer. Everything a run of frames needs.
 ///
@@ -229,8 +215,9 @@ class Session {
   /// occull view), checked as ground_truth()'s. Overwrites the renderer's targets.
   [[nodiscard]] FrameTruth truth_of(const View& view);
 
-  /// Test hooks (see FaultHooks); empty by default.
-  void set_fault_hooks(FaultHooks hooks) { hooks_ = std::move(hooks); }
+  /// Tests only: hooks that break a step on purpose
+  /// (src/lab/fault_hooks.hpp); none by default.
+  void set_fault_hooks(std::shared_ptr<const detail::FaultHooks> hooks) { hooks_ = std::move(hooks); }
 
   /// Makes a culler from an algorithm spec ("chcpp" or
   /// "chcpp:multiquery=off", see parse_algorithm_spec) for this scene;
@@ -418,7 +405,7 @@ class Session {
   std::unique_ptr<LoggingBackend> logger_;  // over backend(), for logged frames; goes before both
   std::unique_ptr<detail::Watchdog> watchdog_;
   std::optional<HardwareProfile> profile_;
-  FaultHooks hooks_;
+  std::shared_ptr<const detail::FaultHooks> hooks_;
   FrameTruth truth_of(const View& view, const detail::FrameLabel& where);
   FrameSampling sampling_;
 };

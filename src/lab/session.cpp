@@ -3,6 +3,7 @@
 // it, the hardware profile, paths and the timed frame itself.
 #include "occull/harness.hpp"
 
+#include "fault_hooks.hpp"
 #include "invariants.hpp"
 #include "oracle.hpp"
 #include "watchdog.hpp"
@@ -333,7 +334,7 @@ FrameStats Session::run_path_frame(Culler& culler, const CameraPath& path, int k
     std::vector<ObjectId> visible;
     visible.reserve((*truth)[std::size_t(k)].visible.size());
     for (const auto& t : (*truth)[std::size_t(k)].visible) visible.push_back(t.id);
-    if (hooks_.oracle_objects) hooks_.oracle_objects(visible);
+    if (hooks_ && hooks_->oracle_objects) hooks_->oracle_objects(visible);
     oracle->set_visible(std::move(visible));
   }
   return run_frame(culler, view_at(path, k, frames), frame_time(path, k, frames));

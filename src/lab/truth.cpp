@@ -2,6 +2,7 @@
 // invariants, and each culler frame checked against it.
 #include "occull/harness.hpp"
 
+#include "fault_hooks.hpp"
 #include "invariants.hpp"
 #include "oracle.hpp"
 #include "watchdog.hpp"
@@ -140,12 +141,12 @@ FrameTruth Session::truth_of(const View& view, const detail::FrameLabel& where) 
   std::vector<ObjectId> in_frustum, outside;
   for (ObjectId id = 0; id < objects.size(); ++id)
     if (view.frustum.classify(objects[id].bounds) != Containment::outside) in_frustum.push_back(id);
-  if (hooks_.truth_objects) hooks_.truth_objects(in_frustum);
+  if (hooks_ && hooks_->truth_objects) hooks_->truth_objects(in_frustum);
 
   FrameTruth t;
   gl::Renderer::PassImages images;
   t.visible = renderer_->visible_pixels(view, in_frustum, &images);
-  if (hooks_.truth_images) hooks_.truth_images(t.visible, images);
+  if (hooks_ && hooks_->truth_images) hooks_->truth_images(t.visible, images);
   // The full scene, for comparison: every opaque object left out of the
   // truth pass, drawn over its depth, must not pass a single sample.
   std::vector<std::uint8_t> drawn(objects.size(), 0);
@@ -172,7 +173,7 @@ std::vector<ObjectId> Session::verify_frame(std::string_view name, const Culler&
                                             int k, const FrameTruth& t, FrameStats& s) {
   const detail::FrameLabel where{scene_spec_, path.name(), k};
   std::vector<float> depth = renderer_->read_depth();
-  if (hooks_.frame_depth) hooks_.frame_depth(depth);
+  if (hooks_ && hooks_->frame_depth) hooks_->frame_depth(depth);
   const Coverage frame = detail::depth_coverage(depth);
   detail::check_frame_within_truth(where, std::string(name), t.coverage, frame);
   if (dynamic_cast<const detail::OracleCuller*>(&culler))
