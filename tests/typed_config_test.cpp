@@ -86,6 +86,23 @@ TEST(TypedConfig, MakesTheCullerItsSpecMakes) {
   EXPECT_GE(differing, cases.size() - 2);
 }
 
+TEST(TypedConfig, AutosCandidatesAreSpecsThatCarryTheirOptions) {
+  Scene scene = test::box_scene(test::scattered_boxes(150));
+  const Bvh bvh = Bvh::build(scene);
+  const SceneIndex index{scene, bvh};
+  Options base;
+  base.set("chcpp.batch=3");
+  base.set("chcpp.tight=off");
+  auto from_spec = make_culler("auto:candidates=chcpp", index, base);
+  auto typed = make_culler(AutoConfig{.candidates = "chcpp:batch=3:tight=off"}, index);
+  const Trace expected = trace(*from_spec);
+  expect_same_trace(trace(*typed), expected, "auto over chcpp:batch=3:tight=off");
+  auto defaults = make_culler(AutoConfig{.candidates = "chcpp"}, index);
+  const Trace plain = trace(*defaults);
+  EXPECT_FALSE(plain.rendered == expected.rendered && plain.queried == expected.queried)
+      << "the options make a difference here";
+}
+
 TEST(TypedConfig, MakesTheSplitScreenItsSpecMakes) {
   Scene scene = test::box_scene(test::scattered_boxes(150));
   const Bvh bvh = Bvh::build(scene);

@@ -182,8 +182,9 @@ struct GridConfig {
 };
 
 /// Adaptive: runs the cheapest of its candidates for this view, learnt from
-/// the measured frame times, with hysteresis. Made from this config, its
-/// candidates run with their defaults; a spec's options reach them
+/// the measured frame times, with hysteresis. Its candidates are specs, so
+/// each may carry its options here (`.candidates = "chcpp:batch=20+vfc"`);
+/// a spec of auto reaches them through the base options
 /// ("auto:candidates=chcpp+vfc" with "chcpp.batch=20").
 struct AutoConfig {
   static constexpr std::string_view algorithm = "auto";
@@ -214,7 +215,9 @@ struct PerTileConfig {
 };
 
 /// Tiled worlds: visibility propagated tile to tile by queries of the common
-/// box (Gomez et al. 2013), CHC++ inside each visible tile.
+/// box (Gomez et al. 2013), CHC++ inside each visible tile. Made from this
+/// config, the tiles' CHC++ runs with its defaults; a spec's base options
+/// ("chcpp.batch=20") reach it.
 struct TilesConfig {
   static constexpr std::string_view algorithm = "tiles";
   std::string local = "chcpp";  ///< culling inside a visible tile: "chcpp" or "" (draw the whole tile)

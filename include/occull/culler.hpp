@@ -293,9 +293,9 @@ struct CullerContext {
 ///
 /// Throws InputError for a value outside its option's range (named as the
 /// option: "option chcpp.batch: 0 is outside [1, 100000]"), a scene of a
-/// kind the algorithm does not run on, or nohc without a profile. An
-/// algorithm that makes others (auto's candidates, tiles' local culler)
-/// makes them with their defaults.
+/// kind the algorithm does not run on, or nohc without a profile. auto's
+/// candidates are specs that carry their options (AutoConfig::candidates);
+/// tiles' local CHC++ runs with its defaults.
 [[nodiscard]] std::unique_ptr<Culler> make_culler(const NoneConfig& config, const SceneIndex& index,
                                                   const CullerContext& context = {});
 [[nodiscard]] std::unique_ptr<Culler> make_culler(const VfcConfig& config, const SceneIndex& index,
