@@ -4,7 +4,7 @@
 // virtual leaves off — misses nothing, in every query mode.
 #include "conservative_walk.hpp"
 #include "gl_test_util.hpp"
-#include "occull/harness.hpp"
+#include "occull/lab.hpp"
 
 #include <gtest/gtest.h>
 

@@ -4,7 +4,7 @@
 // draws everything.
 #pragma once
 
-#include "occull/harness.hpp"
+#include "occull/lab.hpp"
 
 #include <gtest/gtest.h>
 
@@ -53,7 +53,7 @@ inline WalkBaseline walk_baseline(Session& session, const CameraPath& path, int 
 /// so drawing what vfc draws fails. The families that decide by cost whether
 /// to query at all (nohc, auto) may draw what vfc draws where querying does
 /// not pay: they are not bounded (a suite names them in `unbounded`).
-/// Numbers in docs/instrument.md, "Culling, not only conservative".
+/// Numbers in docs/lab.md, "Culling, not only conservative".
 inline double culling_bound(std::string_view spec) {
   const std::string_view name = spec.substr(0, spec.find(':'));
   if (name == "stopwait" || name == "chc") return 0.6;  // measured up to 0.43

@@ -83,7 +83,7 @@ TEST(Counters, EveryCounterAnAlgorithmReportsHasARowAndReachesTheFrame) {
   world.world->follow(world.scene, world_view.eye);
   std::set<std::string_view> names;
   for (const AlgorithmInfo& info : algorithms()) {
-    if (info.harness_only || info.device) continue;
+    if (info.lab_only || info.device) continue;
     const bool tiled = info.scenes == SceneKind::tiled;
     const SceneIndex index = tiled ? SceneIndex{world.scene, no_bvh, world.world.get()} : SceneIndex{boxes, bvh};
     auto culler = make_culler(info.name, index, {}, with_profile(test::hardware_profile()));
@@ -251,7 +251,7 @@ TEST(Counters, RepeatsReduceByMedianOrTheWorst) {
 
 // The docs name every JSON key and, in the table's order, every CSV column.
 TEST(Counters, DocsAgreeWithTheTable) {
-  std::ifstream in(std::string(OCCULL_SOURCE_DIR) + "/docs/instrument.md");
+  std::ifstream in(std::string(OCCULL_SOURCE_DIR) + "/docs/lab.md");
   std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   std::replace(text.begin(), text.end(), '\n', ' ');  // a sentence may wrap
   const auto json_block = text.substr(text.find("## JSON output"));
@@ -261,7 +261,7 @@ TEST(Counters, DocsAgreeWithTheTable) {
   std::string columns = "algorithm, repeat, frame";
   for (const Counter& c : frame_counters()) columns += ", " + std::string(c.name);
   EXPECT_NE(text.find("frames.csv columns: " + columns + "."), std::string::npos)
-      << "docs/instrument.md should say: frames.csv columns: " << columns << ".";
+      << "docs/lab.md should say: frames.csv columns: " << columns << ".";
 }
 
 }  // namespace

@@ -162,7 +162,7 @@ TEST(MakeCuller, TakesSpecsWithOptionsAndAProfileInMemory) {
 
 TEST(Registry, EveryDefaultShownIsAValueItsAlgorithmTakes) {
   for (const AlgorithmInfo& a : algorithms()) {
-    if (a.harness_only) continue;
+    if (a.lab_only) continue;
     const bool conservative = is_conservative(parse_algorithm_spec(a.name));
     for (const OptionInfo& o : a.options) {
       if (o.default_value.starts_with("(")) continue;  // a placeholder: "(calibrated)"
@@ -231,7 +231,7 @@ TEST(MakeSplitScreen, AlgorithmsThatShareViewsMakeThemTogetherTheOthersOnePerVie
   EXPECT_NE(&chcpp->view(0), &chcpp->view(1));
   EXPECT_THROW((void)make_split_screen("chcpp", {scene, bvh}, 0), InputError);
   EXPECT_THROW((void)make_split_screen("grid:nope=1", {scene, bvh}, 2), InputError);
-  EXPECT_THROW((void)make_split_screen("oracle", {scene, bvh}, 2), InputError);  // harness only
+  EXPECT_THROW((void)make_split_screen("oracle", {scene, bvh}, 2), InputError);  // lab only
 }
 
 TEST(Culler, HizOverABackendWithoutDeviceCullingIsTheCallersMistake) {

@@ -2,7 +2,7 @@
 // off, renders every object the ground truth shows, on the embedded scenes,
 // with moving cars, and on a path that walks through object boxes.
 #include "occull/error.hpp"
-#include "occull/harness.hpp"
+#include "occull/lab.hpp"
 #include "conservative_walk.hpp"
 #include "gl_test_util.hpp"
 #include "require_data.hpp"

@@ -4,7 +4,7 @@
 #include "occull/gl/context.hpp"
 #include "occull/gl/painter.hpp"
 #include "occull/gl/renderer.hpp"
-#include "occull/harness.hpp"
+#include "occull/lab.hpp"
 #include "gl_test_util.hpp"
 #include "test_util.hpp"
 

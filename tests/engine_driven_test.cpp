@@ -22,7 +22,7 @@ TEST(EngineDrivenScene, EveryAlgorithmFollowsMovesAdditionsAndRemovals) {
   const View view = test::unsampled(make_view({{0, 0, 0}, 0, 0}, {70.0f, 0.1f, 500.0f}, 64, 64));
   std::size_t rebuilds = 0, removed_seen = 0;
   for (const AlgorithmInfo& info : algorithms()) {
-    if (info.harness_only || !runs_on(info, false)) continue;
+    if (info.lab_only || !runs_on(info, false)) continue;
     if (info.device) continue;  // culls on the device: hiz_gl_test.cpp
     Scene scene = test::box_scene(test::scattered_boxes(120));
     Bvh bvh = Bvh::build(scene);

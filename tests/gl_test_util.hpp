@@ -11,7 +11,7 @@
 namespace occull::test {
 
 /// Renderer options for a width x height target without id writes (the
-/// harness re-draws ids in its untimed truth pass).
+/// lab re-draws ids in its untimed truth pass).
 inline gl::RendererOptions small_target(int width, int height) {
   gl::RendererOptions o;
   o.width = width;

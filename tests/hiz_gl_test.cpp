@@ -51,7 +51,7 @@ struct WallScene {
 };
 
 // One frame of `culler` through a RecordingBackend over `r`: what the device
-// drew, ascending, as the harness reads it back.
+// drew, ascending, as the lab reads it back.
 std::vector<ObjectId> frame(Culler& culler, gl::Renderer& r, const Scene& scene, const View& view) {
   RecordingBackend recorder(r, scene);
   r.begin_frame(view);

@@ -4,7 +4,7 @@
 #include "lab/invariants.hpp"
 #include "gl_test_util.hpp"
 #include "occull/error.hpp"
-#include "occull/harness.hpp"
+#include "occull/lab.hpp"
 #include "test_util.hpp"
 
 #include <gtest/gtest.h>

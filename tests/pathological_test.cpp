@@ -36,7 +36,7 @@ std::string error_of(const CameraPose& pose, const Lens& lens, int w, int h) {
 std::vector<std::pair<std::string, Options>> every_culler() {
   std::vector<std::pair<std::string, Options>> out;
   for (const AlgorithmInfo& a : algorithms()) {
-    if (a.name == "oracle" || !runs_on(a, false)) continue;  // oracle: fed by the harness's truth
+    if (a.name == "oracle" || !runs_on(a, false)) continue;  // oracle: fed by the lab's truth
     if (a.device) continue;  // culls on the device: hiz_gl_test.cpp
     Options o;
     o.set(std::string("nohc.profile=") + OCCULL_SOURCE_DIR + "/tests/data/profile-llvmpipe-320x180.json");

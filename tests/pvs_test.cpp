@@ -4,7 +4,7 @@
 // from the eye's cluster.
 #include "gl_test_util.hpp"
 #include "require_data.hpp"
-#include "occull/harness.hpp"
+#include "occull/lab.hpp"
 #include "occull/q3bsp.hpp"
 
 #include <gtest/gtest.h>

@@ -90,7 +90,7 @@ TEST(QueryOwnership, EveryBvhAlgorithmHandsBackEveryQuery) {
   const View view = make_view({{0, 0, 0}, 0, 0}, {60.0f, 0.1f, 500.0f}, 64, 64);
   std::size_t held_somewhere = 0;
   for (const AlgorithmInfo& info : algorithms()) {
-    if (info.harness_only || !runs_on(info, false)) continue;
+    if (info.lab_only || !runs_on(info, false)) continue;
     if (info.device) continue;  // culls on the device: hiz_gl_test.cpp
     Options options;
     for (const auto& [k, v] : base.values())
@@ -124,7 +124,7 @@ TEST(QueryOwnership, EveryTiledWorldAlgorithmHandsBackEveryQuery) {
   const Bvh none = Bvh::build(std::span<const Aabb>{}, std::span<const std::uint32_t>{});
   std::size_t held_somewhere = 0;
   for (const AlgorithmInfo& info : algorithms()) {
-    if (info.harness_only || !runs_on(info, true)) continue;
+    if (info.lab_only || !runs_on(info, true)) continue;
     auto culler = make_culler(info.name, {bundle.scene, none, bundle.world.get()});
     test::ScriptedBackend backend;
     int frame = 0;

@@ -6,7 +6,7 @@
 #include "occull/gl/context.hpp"
 #include "occull/gl/renderer.hpp"
 #include "occull/recording_backend.hpp"
-#include "occull/harness.hpp"
+#include "occull/lab.hpp"
 #include "gl_test_util.hpp"
 #include "test_util.hpp"
 

@@ -4,7 +4,7 @@
 #include "occull/error.hpp"
 #include "occull/gl/painter.hpp"
 #include "occull/gl/renderer.hpp"
-#include "occull/harness.hpp"
+#include "occull/lab.hpp"
 #include "occull/occlusion_buffer.hpp"
 
 #include <fmt/format.h>
@@ -96,7 +96,7 @@ int cmd_render(const RenderArgs& a) {
   const std::string algo =
       a.algo.empty() ? std::string(occull::vfc_baseline(session.bundle().world != nullptr)) : a.algo;
   check_view_fits(view, algo);
-  if (occull::find_algorithm(occull::parse_algorithm_spec(algo).name).harness_only)
+  if (occull::find_algorithm(occull::parse_algorithm_spec(algo).name).lab_only)
     throw occull::InputError(fmt::format("--algo {} needs each frame's ground truth: bench runs it, render does not",
                                          algo));
   // As bench makes them: specs with options (chcpp:batch=20), nohc with the

@@ -2,7 +2,7 @@
 #include "run_options.hpp"
 
 #include "occull/error.hpp"
-#include "occull/harness.hpp"
+#include "occull/lab.hpp"
 #include "occull/process.hpp"
 #include "occull/report.hpp"
 

@@ -17,7 +17,7 @@
 #include "occull/error.hpp"
 #include "occull/gl/context.hpp"
 #include "occull/gl/painter.hpp"
-#include "occull/harness.hpp"
+#include "occull/lab.hpp"
 
 #include <stb_image_write.h>  // GLFW, GL, ImGui and fmt come with viewer_window.hpp
 
@@ -47,7 +47,7 @@ struct Controls {
 std::vector<std::string> runnable_algorithms(bool tiled) {
   std::vector<std::string> names;
   for (const AlgorithmInfo& a : algorithms())
-    if (!a.harness_only && runs_on(a, tiled)) names.push_back(a.name);
+    if (!a.lab_only && runs_on(a, tiled)) names.push_back(a.name);
   return names;
 }
 

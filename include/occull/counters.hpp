@@ -1,11 +1,11 @@
-// occull — every per-frame counter of the harness, declared once.
+// occull — every per-frame counter of the lab, declared once.
 //
 // One row per FrameStats member says where the counter comes from (the
 // backend's counters; the culler's FrameResult or, by the row's name, its
-// algorithm's counters (Culler::visit_counters); or the harness), how the views of a
+// algorithm's counters (Culler::visit_counters); or the lab), how the views of a
 // split-screen frame combine it, how a run's frames and the repeats reduce
 // it to the summary figure (the AlgorithmSummary member and JSON key of the
-// same row), how frames.csv prints it, and what it means. The harness's
+// same row), how frames.csv prints it, and what it means. The lab's
 // per-frame copy, the split-screen sums, summarize_runs(), the JSON, the CSV
 // columns and the report's legend are all loops over this table: adding a
 // counter is its FrameStats member (and the code that counts it: an
@@ -44,7 +44,7 @@ struct Counter {
   std::string_view name;  ///< the FrameStats member's name; frames.csv's column; an algorithm's counter of that name
   FrameMember frame;      ///< the FrameStats member
   /// The BackendStats counter whose difference over the frame it is
-  /// (std::monostate: the culler or the harness fills it).
+  /// (std::monostate: the culler or the lab fills it).
   BackendMember backend;
   Combine views;    ///< the views of a split-screen frame into the frame: sum, max or mean
   Combine frames;   ///< a run's frames into the run's figure: mean (per frame), sum, max; none: no summary

@@ -193,11 +193,11 @@ enum class SceneKind : std::uint8_t {
 struct AlgorithmInfo {
   std::string name;
   std::string summary;
-  bool conservative = true;   ///< never culls a visible object (verified by the harness)
+  bool conservative = true;   ///< never culls a visible object (verified by the lab)
   std::vector<OptionInfo> options;
-  /// Needs each frame's ground truth, so only the harness can run it
+  /// Needs each frame's ground truth, so only the lab can run it
   /// (`oracle`); make_culler() refuses it.
-  bool harness_only = false;
+  bool lab_only = false;
   SceneKind scenes = SceneKind::bvh;
   /// Its cullers of the views of one frame share state (`grid`: one grid
   /// and one query cap), so make_split_screen() makes them together.
@@ -221,7 +221,7 @@ struct AlgorithmInfo {
 /// that runs on the scene's kind, in presentation order; on a tiled world
 /// also `tiles:local=none` (Gomez et al. 2013's "tile query alone").
 [[nodiscard]] std::vector<std::string> default_algorithms(bool tiled);
-/// The frustum-culling baseline the harness's "vs vfc" ratios divide by:
+/// The frustum-culling baseline the lab's "vs vfc" ratios divide by:
 /// `vfc`, or `tilevfc` on a tiled world.
 [[nodiscard]] std::string_view vfc_baseline(bool tiled) noexcept;
 /// Comma-separated list of algorithm names (for error messages and help).
@@ -244,7 +244,7 @@ struct AlgorithmSpec {
 /// (OptionInfo::approximate_unless_default) — `threshold` > 0 culls nodes
 /// with up to that many visible pixels, and `tiles.box=tile` queries a
 /// tile's own box instead of the common box, so such runs may pop.
-/// The harness reports misses of a conservative run as failures and those
+/// The lab reports misses of a conservative run as failures and those
 /// of any other run as popping.
 [[nodiscard]] bool is_conservative(const AlgorithmSpec& spec);
 

@@ -5,7 +5,7 @@
 // them: on Mesa llvmpipe every glFlush (and every availability poll of a
 // query not yet flushed) ends a batch whose memory is freed; glibc then trims
 // the heap back to the OS and the next batch faults it in again. A culler
-// that flushes more often than another pays for that churn, so the harness
+// that flushes more often than another pays for that churn, so the lab
 // counts faults and kernel time per frame, and the tools set an allocator
 // policy an engine would use (no trimming of a heap it is about to reuse).
 #pragma once

@@ -2,7 +2,7 @@
 // report folder with Markdown and SVG charts.
 #pragma once
 
-#include "occull/harness.hpp"
+#include "occull/lab.hpp"
 
 #include <iosfwd>
 #include <string>

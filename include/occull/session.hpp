@@ -1,6 +1,6 @@
 // occull — a scene set up on the GL device for runs of frames (Session),
 // the ground truth of a frame and the verification of a culler's frames
-// against it. The harness's bench types are in occull/bench.hpp.
+// against it. The lab's bench types are in occull/bench.hpp.
 //
 // Ground truth: an untimed pass per frame renders every object inside the
 // view frustum into the object-id buffer; the truth set is every object with
@@ -86,7 +86,7 @@ inline constexpr double kDepthErrorTolerance = 1e-4;
 /// there. Mesa's llvmpipe does, in its early depth test, for sub-pixel
 /// sliver triangles (a terrain seen edge-on far away): it extrapolates
 /// their depth outside their vertices' range, so a tile 528 m away shows one pixel at 206 m, through
-/// a rock at 417 m (docs/instrument.md, "Depth errors of the rasteriser").
+/// a rock at 417 m (docs/lab.md, "Depth errors of the rasteriser").
 /// A pixel whose ray misses the box (snapping widened the outline) or
 /// starts inside it counts as the object's own. Ascending ids.
 /// Preconditions: ids and depth hold width * height values, `view` is the

@@ -6,7 +6,7 @@
 #include "occull/culler.hpp"
 #include "occull/gl/context.hpp"
 #include "occull/gl/renderer.hpp"
-#include "occull/harness.hpp"
+#include "occull/lab.hpp"
 
 #include <cstdint>
 #include <functional>

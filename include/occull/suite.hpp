@@ -3,7 +3,7 @@
 // worst ratio to vfc and to the oracle).
 #pragma once
 
-#include "occull/harness.hpp"
+#include "occull/lab.hpp"
 
 #include <iosfwd>
 #include <span>

@@ -4,7 +4,7 @@
 // setting, in the shape of Seletsky's Tables 5.x (Seletsky 2013).
 #pragma once
 
-#include "occull/harness.hpp"
+#include "occull/lab.hpp"
 
 #include <cstddef>
 #include <cstdint>

@@ -20,7 +20,7 @@
 // the world (kParkedY), where no frustum reaches.
 //
 // Ground truth needs no global structure: every cell of the window is
-// placed, so the harness's brute-force pass over the scene's objects sees
+// placed, so the lab's brute-force pass over the scene's objects sees
 // every tile instance within the far plane.
 #pragma once
 #include "occull/bvh.hpp"
@@ -69,7 +69,7 @@ class TiledWorld {
   /// Where ids a cell's tile does not use are put (scene units, Y).
   static constexpr float kParkedY = -1.0e6f;
   /// The widest viewport (width / height) a window sized by reach() holds
-  /// every cell in the frustum of; the harness refuses wider ones.
+  /// every cell in the frustum of; the lab refuses wider ones.
   static constexpr float kMaxAspect = 2.0f;
   /// Distance from the eye to the far corners of `lens`'s frustum at
   /// kMaxAspect (scene units): the reach to size a window with.
@@ -122,7 +122,7 @@ class TiledWorld {
   std::size_t follow(Scene& scene, const glm::vec3& eye);
   /// Whether every point of `view`'s frustum lies over the window's cells
   /// (its eight corners do: the frustum is their convex hull), so that the
-  /// placed cells are all a frame can see. The harness checks it on every
+  /// placed cells are all a frame can see. The lab checks it on every
   /// ground-truth frame.
   [[nodiscard]] bool covers(const View& view) const;
   /// Cells placed since construction (a measure of the walk).

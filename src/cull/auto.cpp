@@ -628,7 +628,7 @@ Registration auto_registration() {
         std::vector<Candidate> candidates;
         for (const std::string& name : names) {
           const AlgorithmInfo& info = find_algorithm(parse_algorithm_spec(name, o).name);
-          if (info.name == "auto" || info.harness_only || !info.conservative)
+          if (info.name == "auto" || info.lab_only || !info.conservative)
             throw InputError(detail::format("option auto.candidates: '{}' cannot be a candidate (auto runs conservative "
                                          "cullers other than itself)",
                                          name));

@@ -183,7 +183,7 @@ class ConfigTable {
   std::vector<Field> fields_;
 };
 
-/// How the registry makes an algorithm from options (null: harness only).
+/// How the registry makes an algorithm from options (null: lab only).
 using Factory = std::function<std::unique_ptr<Culler>(const SceneIndex&, const Options&, const CullerContext&)>;
 
 /// How the registry makes the cullers of several views together (null: one

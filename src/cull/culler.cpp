@@ -28,7 +28,7 @@ const std::vector<Registration>& registry() {
         detail::soc_registration(),     detail::auto_registration(),
         detail::tilevfc_registration(), detail::pertile_registration(), detail::tiles_registration(),
     };
-    // The oracle is made by the harness (it needs each frame's ground truth).
+    // The oracle is made by the lab (it needs each frame's ground truth).
     r.push_back({{"oracle", "renders exactly the ground-truth visible set, no queries: the lower bound (occull bench only)",
                   true, {}, true, SceneKind::any},
                  {},
@@ -295,12 +295,12 @@ std::vector<ObjectId> objects_not_drawn(const Scene& scene, const View& view, st
 namespace {
 
 // The registration of algorithm `name`, checked to run on `index`'s kind of
-// scene and outside the harness. Throws InputError otherwise.
+// scene and outside the lab. Throws InputError otherwise.
 const Registration& makeable(std::string_view name, const SceneIndex& index) {
   const Registration* entry = find(name);
   if (!entry) (void)find_algorithm(name);  // throws, listing the valid names
   if (!entry->make)
-    throw InputError(detail::format("{} needs each frame's ground truth: it runs only in the harness "
+    throw InputError(detail::format("{} needs each frame's ground truth: it runs only in the lab "
                                  "(occull bench)",
                                  entry->info.name));
   const bool tiled = index.world != nullptr;

@@ -1,6 +1,6 @@
 // Running benches: every algorithm over the same views and frames,
 // warmed up, verified and repeated.
-#include "occull/harness.hpp"
+#include "occull/lab.hpp"
 
 #include "occull/counters.hpp"
 #include "occull/error.hpp"
@@ -134,14 +134,14 @@ int warmup_frame(const BenchConfig& config, int w) {
 // The cullers of the views of one run: one view's from the session; for
 // more, make_split_screen's (an algorithm that shares state between views
 // makes them together), or the session's, one per view, for the
-// harness-only oracle.
+// lab-only oracle.
 struct ViewCullers {
   std::unique_ptr<SplitScreen> split;
   std::vector<std::unique_ptr<Culler>> own;
 
   ViewCullers(Session& session, const std::string& name, const Options& options, int views) {
     const AlgorithmSpec spec = parse_algorithm_spec(name, options);
-    if (views == 1 || find_algorithm(spec.name).harness_only)
+    if (views == 1 || find_algorithm(spec.name).lab_only)
       for (int k = 0; k < views; ++k) own.push_back(session.make(name, options));
     else
       split = make_split_screen(name, session.index(), views, options, session.culler_context());
@@ -207,7 +207,7 @@ BenchResult run_bench(const BenchConfig& config, const ProgressFn& progress) {
   std::vector<std::string> names = config.algorithms;
   const auto check_names = [&] {
     for (const auto& n : names) {
-      if (find_algorithm(parse_algorithm_spec(n).name).harness_only && !config.verify)
+      if (find_algorithm(parse_algorithm_spec(n).name).lab_only && !config.verify)
         throw InputError(fmt::format("{} needs ground truth: drop it or turn verification on", n));
     }
   };

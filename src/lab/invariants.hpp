@@ -25,7 +25,7 @@
 #pragma once
 
 #include "occull/gl/renderer.hpp"
-#include "occull/harness.hpp"
+#include "occull/lab.hpp"
 
 #include <cstdint>
 #include <span>

@@ -88,7 +88,7 @@ std::vector<std::string> verdict_lines(const BenchResult& r) {
       depth_errors += fmt::format("{}{} {}", depth_errors.empty() ? "" : ", ", a.name, a.depth_error_objects);
   if (!depth_errors.empty())
     lines.push_back("left out, not missed: objects the rasteriser showed only through depth errors (fragments nearer "
-                    "than their own box; docs/instrument.md): " + depth_errors);
+                    "than their own box; docs/lab.md): " + depth_errors);
   return lines;
 }
 

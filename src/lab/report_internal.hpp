@@ -3,7 +3,7 @@
 // it) and writing one file of a report folder.
 #pragma once
 
-#include "occull/harness.hpp"
+#include "occull/lab.hpp"
 
 #include <nlohmann/json.hpp>
 

@@ -1,7 +1,7 @@
 // Session: the device and the scene for a run of frames (scene, BVH, GL
 // context, renderer, stall guard, logger, watchdog), the cullers made for
 // it, the hardware profile, paths and the timed frame itself.
-#include "occull/harness.hpp"
+#include "occull/lab.hpp"
 
 #include "fault_hooks.hpp"
 #include "invariants.hpp"

@@ -1,7 +1,7 @@
 // Summarising: runs of frames into one summary per algorithm (the
 // counters as occull/counters.hpp declares them, and the figures derived
 // from them).
-#include "occull/harness.hpp"
+#include "occull/lab.hpp"
 
 #include "occull/counters.hpp"
 

@@ -1,6 +1,6 @@
 // Ground truth and verification: the truth pass of a frame with its
 // invariants, and each culler frame checked against it.
-#include "occull/harness.hpp"
+#include "occull/lab.hpp"
 
 #include "fault_hooks.hpp"
 #include "invariants.hpp"

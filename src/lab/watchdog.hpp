@@ -1,4 +1,4 @@
-// Internal: the harness's bound on its own waits. A GL call that never
+// Internal: the lab's bound on its own waits. A GL call that never
 // returns (a hung device or driver) cannot be interrupted, so when a step
 // runs past its time the watchdog says which step hung and ends the
 // process (exit 1) rather than leaving a benchmark hanging forever.

@@ -1,4 +1,4 @@
-// occull — the measuring harness: flies a camera path through a scene with
+// occull — the lab: flies a camera path through a scene with
 // each culler on the reference renderer, records what every frame cost and
 // checks every frame against ground truth.
 //

@@ -1,5 +1,5 @@
 // Ground truth, verification, the oracle and the report writers.
-#include "occull/harness.hpp"
+#include "occull/lab.hpp"
 #include "gl_test_util.hpp"
 #include "occull/error.hpp"
 #include "occull/report.hpp"
@@ -68,9 +68,9 @@ std::optional<ObjectId> always_visible(const std::vector<FrameTruth>& truth) {
   return std::nullopt;
 }
 
-// The names in docs/instrument.md's "JSON output" block (every "quoted" word).
+// The names in docs/lab.md's "JSON output" block (every "quoted" word).
 std::set<std::string> readme_json_names() {
-  std::ifstream in(std::string(OCCULL_SOURCE_DIR) + "/docs/instrument.md");
+  std::ifstream in(std::string(OCCULL_SOURCE_DIR) + "/docs/lab.md");
   const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   const auto heading = text.find("## JSON output");
   const auto open = text.find("```", heading);
@@ -97,7 +97,7 @@ void collect_keys(const nlohmann::json& j, std::set<std::string>& keys) {
   }
 }
 
-class HarnessTest : public ::testing::Test {
+class LabTest : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
     session_ = std::make_unique<Session>(kSmallCity, small_target());
@@ -110,9 +110,9 @@ class HarnessTest : public ::testing::Test {
   static const CameraPath* path_;
   static std::vector<FrameTruth> truth_;
 };
-std::unique_ptr<Session> HarnessTest::session_;
-const CameraPath* HarnessTest::path_ = nullptr;
-std::vector<FrameTruth> HarnessTest::truth_;
+std::unique_ptr<Session> LabTest::session_;
+const CameraPath* LabTest::path_ = nullptr;
+std::vector<FrameTruth> LabTest::truth_;
 
 }  // namespace
 
@@ -281,7 +281,7 @@ TEST(GroundTruth, TranslucentObjectsAreVisibleWithoutHidingWhatIsBehind) {
   EXPECT_EQ(visible[1].id, 1u);
 }
 
-TEST_F(HarnessTest, TruthIsNonEmptyAndSortedForEveryFrame) {
+TEST_F(LabTest, TruthIsNonEmptyAndSortedForEveryFrame) {
   ASSERT_EQ(truth_.size(), std::size_t(kFrames));
   for (const FrameTruth& t : truth_) {
     EXPECT_FALSE(t.visible.empty());
@@ -290,7 +290,7 @@ TEST_F(HarnessTest, TruthIsNonEmptyAndSortedForEveryFrame) {
   }
 }
 
-TEST_F(HarnessTest, VfcAndNoneMissNothing) {
+TEST_F(LabTest, VfcAndNoneMissNothing) {
   for (const char* name : {"none", "vfc"}) {
     auto culler = session_->make(name, {});
     const AlgorithmRun run = session_->run_path(name, *culler, *path_, kFrames, &truth_);
@@ -303,7 +303,7 @@ TEST_F(HarnessTest, VfcAndNoneMissNothing) {
   }
 }
 
-TEST_F(HarnessTest, OracleRendersExactlyTheTruth) {
+TEST_F(LabTest, OracleRendersExactlyTheTruth) {
   auto oracle = session_->make("oracle", {});
   const AlgorithmRun run = session_->run_path("oracle", *oracle, *path_, kFrames, &truth_);
   for (std::size_t k = 0; k < run.frames.size(); ++k) {
@@ -314,7 +314,7 @@ TEST_F(HarnessTest, OracleRendersExactlyTheTruth) {
   }
 }
 
-TEST_F(HarnessTest, VerificationCatchesACullerThatDropsAVisibleObject) {
+TEST_F(LabTest, VerificationCatchesACullerThatDropsAVisibleObject) {
   const auto victim = always_visible(truth_);
   ASSERT_TRUE(victim.has_value()) << "the turn path keeps the crossing under the camera in view";
   DroppingCuller broken(session_->make("vfc", {}), *victim);
@@ -332,12 +332,12 @@ TEST_F(HarnessTest, VerificationCatchesACullerThatDropsAVisibleObject) {
   EXPECT_EQ(summary[0].frames_with_misses, std::uint64_t(kFrames));
 }
 
-TEST_F(HarnessTest, OracleWithoutTruthIsRefused) {
+TEST_F(LabTest, OracleWithoutTruthIsRefused) {
   auto oracle = session_->make("oracle", {});
   EXPECT_THROW(session_->run_path("oracle", *oracle, *path_, 2, nullptr), InputError);
 }
 
-TEST(Harness, RecordsMemoryEveryThousandFrames) {
+TEST(Lab, RecordsMemoryEveryThousandFrames) {
   Session session("tiles_city:far=150", test::small_target(64, 36));
   auto culler = session.make("tiles", {});
   const AlgorithmRun run = session.run_path("tiles", *culler, session.path("walk10k"), 2000, nullptr);
@@ -366,7 +366,7 @@ TEST(Report, JsonCarriesEveryDocumentedField) {
   BenchResult r = run_bench(c);
   EXPECT_EQ(r.runs.size(), 6u);
   EXPECT_EQ(r.runs[3].name, "vfc");  // interleaved: A B C A B C
-  // Memory is sampled every 1000 frames (Harness.RecordsMemoryEveryThousandFrames):
+  // Memory is sampled every 1000 frames (Lab.RecordsMemoryEveryThousandFrames):
   // one sample stands in, so that its fields are seen.
   EXPECT_TRUE(r.summaries[0].memory.empty());
   r.summaries[0].memory.push_back({1000, 100.0, 2.0});
@@ -462,7 +462,7 @@ TEST(Bench, SplitScreenRunsEachViewOnItsPathAndReportsTheFrameAndEachView) {
   EXPECT_THROW((void)run_bench(c), InputError);
 }
 
-// The harness's watchdog: a step that does not finish is named once its time
+// The lab's watchdog: a step that does not finish is named once its time
 // is up; a step that finishes is never reported. (No timing is asserted: the
 // first waits as long as the watchdog takes, the second uses a time no test
 // machine reaches.)
