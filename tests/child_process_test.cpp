@@ -1,6 +1,6 @@
 // run_in_child: whatever the work does in the child, the caller gets its
 // bytes or an InputError saying how it ended, and goes on.
-#include "core/child_process.hpp"
+#include "scenes/child_process.hpp"
 #include "occull/error.hpp"
 
 #include <gtest/gtest.h>

@@ -1,7 +1,7 @@
 // Internal: loading `file:PATH` scenes through assimp.
 #pragma once
 
-#include "../core/child_process.hpp"
+#include "child_process.hpp"
 #include "occull/input_limits.hpp"
 #include "occull/scenes.hpp"
 
