@@ -249,6 +249,25 @@ TEST(Counters, RepeatsReduceByMedianOrTheWorst) {
   EXPECT_EQ(a.missed_objects, 5u);
 }
 
+TEST(Counters, FrameTimesSummariseToTheirMeanMedianP95MinAndMax) {
+  BenchResult r;
+  for (int rep = 0; rep < 3; ++rep) {
+    std::vector<FrameStats> frames;
+    for (double ms : {4.0, 1.0, 3.0, 2.0, 10.0 * (rep + 1)}) {
+      FrameStats f;
+      f.frame_ms = ms;
+      frames.push_back(f);
+    }
+    r.runs.push_back({"chc", rep, true, std::move(frames), 0});
+  }
+  const Summary s = summarize_runs(r.runs).at(0).frame_ms;  // each figure: the median of the repeats'
+  EXPECT_DOUBLE_EQ(s.mean, 6.0);    // the repeats: 4, 6 and 8
+  EXPECT_DOUBLE_EQ(s.median, 3.0);
+  EXPECT_DOUBLE_EQ(s.p95, 20.0);    // nearest rank of 5: the largest
+  EXPECT_DOUBLE_EQ(s.min, 1.0);
+  EXPECT_DOUBLE_EQ(s.max, 20.0);
+}
+
 // The docs name every JSON key and, in the table's order, every CSV column.
 TEST(Counters, DocsAgreeWithTheTable) {
   std::ifstream in(std::string(OCCULL_SOURCE_DIR) + "/docs/lab.md");
