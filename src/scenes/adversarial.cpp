@@ -94,10 +94,16 @@ Mesh panel(float w, float h) {
 // A small mesh of 10-30 triangles: a capped prism or a cone.
 Mesh small_mesh(Rng& rng, float size) {
   MeshBuilder b;
-  if (rng.chance(0.5f))
-    b.prism({0, 0, 0}, 0.5f * size, size * rng.uniform(0.4f, 1.6f), rng.integer(4, 10));
-  else
-    b.cone({0, 0, 0}, 0.5f * size, size * rng.uniform(0.5f, 2.0f), rng.integer(5, 15));
+  // The random draws one by one, in the order GCC evaluated them as one
+  // call's arguments (C++ leaves it open; GCC: right to left), so the scenes
+  // stay as they were. The same below wherever draws shared one call.
+  if (rng.chance(0.5f)) {
+    const int sides = rng.integer(4, 10);
+    b.prism({0, 0, 0}, 0.5f * size, size * rng.uniform(0.4f, 1.6f), sides);
+  } else {
+    const int sides = rng.integer(5, 15);
+    b.cone({0, 0, 0}, 0.5f * size, size * rng.uniform(0.5f, 2.0f), sides);
+  }
   return b.take();
 }
 
@@ -167,9 +173,13 @@ void build_tiny(Stage& s, int count) {
         const glm::vec3 dir = glm::normalize(w.b - w.a);
         const glm::vec3 side(-dir.z, 0, dir.x);
         const bool at_b = s.rng.chance(0.5f);
-        at = (at_b ? w.b : w.a) + (at_b ? 1.0f : -1.0f) * dir * (s.rng.uniform(-0.5f, 0.05f) * size) +
-             side * (s.rng.chance(0.5f) ? 1.0f : -1.0f) * (0.5f * w.thickness + s.rng.uniform(0.3f, 3.0f)) +
-             glm::vec3(0, s.rng.uniform(0.0f, w.height), 0);
+        // One draw per statement, in the order GCC evaluated the one expression
+        // (glm's operators are calls: their arguments right to left).
+        const float height = s.rng.uniform(0.0f, w.height);
+        const float off = 0.5f * w.thickness + s.rng.uniform(0.3f, 3.0f);
+        const float sign = s.rng.chance(0.5f) ? 1.0f : -1.0f;
+        const float along = s.rng.uniform(-0.5f, 0.05f) * size;
+        at = (at_b ? w.b : w.a) + (at_b ? 1.0f : -1.0f) * dir * along + side * sign * off + glm::vec3(0, height, 0);
       }
     }
     s.add(std::move(mesh), s.m.prop, OccluderClass::never, placed(at, yaw));
@@ -185,11 +195,13 @@ void build_thin(Stage& s, int count) {
                                    : s.rng.uniform(0.0f, glm::two_pi<float>());
     if (kind < 0.3f) {  // decal on the ground, exactly coplanar or 1 mm above
       const float y = s.rng.chance(0.5f) ? 0.0f : 0.001f;
-      s.add(flat_quad(s.rng.uniform(0.3f, 3.0f), s.rng.uniform(0.3f, 3.0f)), s.m.decal, OccluderClass::never,
-            placed({p.x, y, p.y}, yaw));
+      const float depth = s.rng.uniform(0.3f, 3.0f);  // drawn before the width (GCC's order, above)
+      const float width = s.rng.uniform(0.3f, 3.0f);
+      s.add(flat_quad(width, depth), s.m.decal, OccluderClass::never, placed({p.x, y, p.y}, yaw));
     } else if (kind < 0.5f) {  // road marking: long, narrow, flat
-      s.add(flat_quad(s.rng.uniform(0.1f, 0.15f), s.rng.uniform(2.0f, 6.0f)), s.m.decal, OccluderClass::never,
-            placed({p.x, 0.002f, p.y}, yaw));
+      const float depth = s.rng.uniform(2.0f, 6.0f);  // drawn before the width (GCC's order, above)
+      const float width = s.rng.uniform(0.1f, 0.15f);
+      s.add(flat_quad(width, depth), s.m.decal, OccluderClass::never, placed({p.x, 0.002f, p.y}, yaw));
     } else if (kind < 0.65f) {  // kerb
       MeshBuilder b;
       const float len = s.rng.uniform(2.0f, 10.0f);
@@ -197,8 +209,12 @@ void build_thin(Stage& s, int count) {
       s.add(b.take(), s.m.prop, OccluderClass::sometimes, placed({p.x, 0, p.y}, yaw));
     } else if (kind < 0.85f) {  // single-sided panel or glass, zero thickness when axis-aligned
       const bool glass = s.rng.chance(0.2f);
-      s.add(panel(s.rng.uniform(0.3f, 2.0f), s.rng.uniform(0.3f, 2.0f)), glass ? s.m.glass : s.m.prop,
-            OccluderClass::never, placed({p.x, s.rng.uniform(0.0f, 1.5f), p.y}, yaw));
+      // GCC's order (above): the height, then the panel's second and first side.
+      const float height = s.rng.uniform(0.0f, 1.5f);
+      const float second = s.rng.uniform(0.3f, 2.0f);
+      const float first = s.rng.uniform(0.3f, 2.0f);
+      s.add(panel(first, second), glass ? s.m.glass : s.m.prop, OccluderClass::never,
+            placed({p.x, height, p.y}, yaw));
     } else {  // thin pole
       MeshBuilder b;
       const float w = s.rng.uniform(0.02f, 0.06f);
@@ -245,8 +261,9 @@ void build_coplanar(Stage& s, int count) {
       const glm::vec3 normal(-dir.z, 0, dir.x);
       const float sign = s.rng.chance(0.5f) ? 1.0f : -1.0f;
       const float off = 0.5f * w.thickness + (s.rng.chance(0.5f) ? 0.0f : 0.001f);
-      const glm::vec3 at = glm::mix(w.a, w.b, s.rng.uniform(0.1f, 0.9f)) + sign * off * normal +
-                           glm::vec3(0, s.rng.uniform(0.0f, std::max(0.0f, w.height - size)), 0);
+      const float height = s.rng.uniform(0.0f, std::max(0.0f, w.height - size));  // before `along` (GCC's order)
+      const float along = s.rng.uniform(0.1f, 0.9f);
+      const glm::vec3 at = glm::mix(w.a, w.b, along) + sign * off * normal + glm::vec3(0, height, 0);
       const float yaw = std::atan2(sign * normal.x, sign * normal.z);  // panel faces +Z before the turn
       s.add(panel(size, size), s.m.decal, OccluderClass::never, placed(at, yaw));
       ++made;
@@ -268,7 +285,8 @@ void build_near(Stage& s, int count) {
     if (kind < 0.5f) {  // a pole 2-50 cm beside the eye
       MeshBuilder mb;
       const float w = s.rng.uniform(0.02f, 0.1f);
-      const float lateral = (s.rng.chance(0.5f) ? 1.0f : -1.0f) * s.rng.uniform(0.02f, 0.5f);
+      const float sign = s.rng.chance(0.5f) ? 1.0f : -1.0f;  // one draw per statement (GCC's order)
+      const float lateral = sign * s.rng.uniform(0.02f, 0.5f);
       const glm::vec3 p = at + lateral * side;
       mb.box({{p.x - 0.5f * w, 0, p.z - 0.5f * w}, {p.x + 0.5f * w, kEye + s.rng.uniform(-0.3f, 1.5f), p.z + 0.5f * w}},
              MeshBuilder::no_bottom);
@@ -291,7 +309,9 @@ void build_near(Stage& s, int count) {
     } else if (kind < 0.9f) {  // a box the eye passes through
       MeshBuilder mb;
       const float r = s.rng.uniform(0.3f, 2.0f);
-      const glm::vec3 c = at + glm::vec3(s.rng.uniform(-0.5f, 0.5f) * r, 0, s.rng.uniform(-0.5f, 0.5f) * r);
+      const float dz = s.rng.uniform(-0.5f, 0.5f) * r;  // before dx (GCC's order, above)
+      const float dx = s.rng.uniform(-0.5f, 0.5f) * r;
+      const glm::vec3 c = at + glm::vec3(dx, 0, dz);
       mb.box({{c.x - r, std::max(0.0f, c.y - r), c.z - r}, {c.x + r, c.y + r, c.z + r}});
       s.add(mb.take(), s.m.prop, OccluderClass::sometimes);
       ++made;
@@ -344,13 +364,15 @@ void build_farout(Stage& s, int count) {
       const float size = s.rng.uniform(0.01f, 0.05f);
       const float where = s.rng.uniform();
       glm::vec3 local;
-      if (where < 0.5f)  // behind it
+      if (where < 0.5f) {  // behind it
         local = {s.rng.uniform(-0.45f, 0.45f) * w, s.rng.uniform(0.0f, h - size), -s.rng.uniform(0.02f, 0.3f)};
-      else if (where < 0.85f)  // behind a side edge, peeking past it by 0.5-3 mm
-        local = {(s.rng.chance(0.5f) ? 1.0f : -1.0f) * (0.5f * w + s.rng.uniform(0.0005f, 0.003f) - 0.5f * size),
-                 s.rng.uniform(0.0f, h - size), -s.rng.uniform(0.01f, 0.1f)};
-      else  // on its top edge, just behind it
+      } else if (where < 0.85f) {  // behind a side edge, peeking past it by 0.5-3 mm
+        const float sign = s.rng.chance(0.5f) ? 1.0f : -1.0f;  // one draw per statement (GCC's order)
+        const float peek = s.rng.uniform(0.0005f, 0.003f);
+        local = {sign * (0.5f * w + peek - 0.5f * size), s.rng.uniform(0.0f, h - size), -s.rng.uniform(0.01f, 0.1f)};
+      } else {  // on its top edge, just behind it
         local = {s.rng.uniform(-0.45f, 0.45f) * w, h, -0.5f * size - 0.001f};
+      }
       s.add(small_mesh(s.rng, size), s.m.prop, OccluderClass::never, at * placed(local, s.rng.uniform(0.0f, 6.3f)));
     }
   }

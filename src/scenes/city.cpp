@@ -187,10 +187,14 @@ class CityBuilder {
 
   void make_plaza(const Aabb& lot) {
     for (float x = lot.min.x + 4.0f; x < lot.max.x - 2.0f; x += 7.0f)
-      for (float z = lot.min.z + 4.0f; z < lot.max.z - 2.0f; z += 7.0f)
-        scene_.add_object(trees_[std::size_t(rng_.integer(0, 2))], foliage_,
-                          placed({x, kCurbHeight, z}, rng_.uniform(0.0f, 6.28f)),
-                          OccluderClass::sometimes);
+      for (float z = lot.min.z + 4.0f; z < lot.max.z - 2.0f; z += 7.0f) {
+        // The random draws one by one, in the order GCC evaluated them as one
+        // call's arguments (C++ leaves it open; GCC: right to left), so the
+        // city stays as it was. The same wherever draws shared one call.
+        const float yaw = rng_.uniform(0.0f, 6.28f);
+        const MeshId tree = trees_[std::size_t(rng_.integer(0, 2))];
+        scene_.add_object(tree, foliage_, placed({x, kCurbHeight, z}, yaw), OccluderClass::sometimes);
+      }
   }
 
   // A building on `lot` (only x/z of lot are used): core, pilasters, floor
@@ -286,9 +290,11 @@ class CityBuilder {
       for (float s = lo; s <= hi; s += 9.0f, ++k) {
         if (k % 2 == 0)
           scene_.add_object(lamp_, metal_, placed(at(s, 0.8f), face_out), OccluderClass::never);
-        else
-          scene_.add_object(trees_[std::size_t(rng_.integer(0, 2))], foliage_,
-                            placed(at(s, 1.3f), rng_.uniform(0.0f, 6.28f)), OccluderClass::sometimes);
+        else {
+          const float yaw = rng_.uniform(0.0f, 6.28f);  // before the mesh (GCC's order, make_plaza)
+          const MeshId tree = trees_[std::size_t(rng_.integer(0, 2))];
+          scene_.add_object(tree, foliage_, placed(at(s, 1.3f), yaw), OccluderClass::sometimes);
+        }
       }
       for (int b = rng_.integer(0, 2); b > 0; --b)
         scene_.add_object(bench_, wood_, placed(at(rng_.uniform(lo, hi), 2.2f), face_out + glm::pi<float>()),
@@ -304,9 +310,9 @@ class CityBuilder {
         if (!rng_.chance(0.45f)) continue;
         const float across = edge + outward * 1.3f;
         const glm::vec3 pos = along_x ? glm::vec3(s, 0.0f, across) : glm::vec3(across, 0.0f, s);
-        scene_.add_object(car_meshes_[std::size_t(rng_.integer(0, 1))],
-                          cars_[std::size_t(rng_.integer(0, int(cars_.size()) - 1))],
-                          placed(pos, along_yaw), OccluderClass::sometimes);
+        const MaterialId paint = cars_[std::size_t(rng_.integer(0, int(cars_.size()) - 1))];  // GCC's order
+        const MeshId car = car_meshes_[std::size_t(rng_.integer(0, 1))];
+        scene_.add_object(car, paint, placed(pos, along_yaw), OccluderClass::sometimes);
       }
     }
   }
@@ -322,8 +328,7 @@ class CityBuilder {
                           {b.max.x, 0.0f, b.max.z}, {b.max.x, 0.0f, b.min.z}};
       motion.speed = rng_.uniform(6.0f, 12.0f);
       motion.start_offset = rng_.uniform(0.0f, 4.0f * (kBlock + 8.0f));
-      // The paint drawn before the mesh: the order in which GCC evaluated the
-      // arguments of the call these came from, so the traffic stays as it was.
+      // The paint drawn before the mesh (GCC's order, make_plaza).
       const MaterialId paint = cars_[std::size_t(rng_.integer(0, int(cars_.size()) - 1))];
       const MeshId car = car_meshes_[std::size_t(rng_.integer(0, 1))];
       add_scripted_object(scene_, scripted_, car, paint, std::move(motion), OccluderClass::sometimes);

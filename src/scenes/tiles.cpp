@@ -164,17 +164,22 @@ Tile forest_tile(const Materials& m, const Shared& s, Rng& rng, int index) {
   t.name = "forest-" + std::to_string(index);
   t.objects.push_back({s.ground, m.grass, glm::mat4(1.0f), OccluderClass::always});
   const int trees = rng.integer(35, 70);
-  for (int i = 0; i < trees; ++i)
-    t.objects.push_back({s.trees[rng.integer(0, 2)], m.foliage,
-                         at(rng.uniform(5.0f, kCell - 5.0f), 0.0f, rng.uniform(5.0f, kCell - 5.0f),
-                            rng.uniform(0, 6.28f), rng.uniform(0.8f, 1.4f)),
-                         OccluderClass::sometimes});
+  // The random draws one by one, in the order GCC evaluated them as one
+  // call's arguments (C++ leaves it open; GCC: right to left), so the tiles
+  // stay as they were. The same for the rocks and lamps below.
+  for (int i = 0; i < trees; ++i) {
+    const MeshId tree = s.trees[rng.integer(0, 2)];
+    const float scale = rng.uniform(0.8f, 1.4f), yaw = rng.uniform(0, 6.28f);
+    const float z = rng.uniform(5.0f, kCell - 5.0f), x = rng.uniform(5.0f, kCell - 5.0f);
+    t.objects.push_back({tree, m.foliage, at(x, 0.0f, z, yaw, scale), OccluderClass::sometimes});
+  }
   const int rocks = rng.integer(3, 8);
-  for (int i = 0; i < rocks; ++i)
-    t.objects.push_back({s.rocks[rng.integer(0, 1)], m.stone,
-                         at(rng.uniform(5.0f, kCell - 5.0f), 0.0f, rng.uniform(5.0f, kCell - 5.0f),
-                            rng.uniform(0, 6.28f), rng.uniform(0.7f, 1.8f)),
-                         OccluderClass::never});
+  for (int i = 0; i < rocks; ++i) {
+    const MeshId rock = s.rocks[rng.integer(0, 1)];
+    const float scale = rng.uniform(0.7f, 1.8f), yaw = rng.uniform(0, 6.28f);
+    const float z = rng.uniform(5.0f, kCell - 5.0f), x = rng.uniform(5.0f, kCell - 5.0f);
+    t.objects.push_back({rock, m.stone, at(x, 0.0f, z, yaw, scale), OccluderClass::never});
+  }
   return t;
 }
 
@@ -196,10 +201,11 @@ Tile square_tile(Scene& scene, const Materials& m, const Shared& s, Rng& rng, in
                             -a + glm::half_pi<float>()),
                          OccluderClass::never});
   }
-  for (int i = 0; i < 4; ++i)
-    t.objects.push_back({s.lamp, m.metal,
-                         at(rng.chance(0.5f) ? 12.0f : kCell - 12.0f, 0.0f, rng.uniform(10.0f, kCell - 10.0f)),
-                         OccluderClass::never});
+  for (int i = 0; i < 4; ++i) {
+    const float z = rng.uniform(10.0f, kCell - 10.0f);  // before x (GCC's order, above)
+    const float x = rng.chance(0.5f) ? 12.0f : kCell - 12.0f;
+    t.objects.push_back({s.lamp, m.metal, at(x, 0.0f, z), OccluderClass::never});
+  }
   return t;
 }
 
