@@ -222,6 +222,98 @@ TEST(OcclusionBuffer, ReversedZHidesWhatIsBehindOnly) {
   EXPECT_FALSE(f.hidden(box(3.2f, 4.7f, 2.2f, 3.6f, 3.0f)));
 }
 
+// Rule 10: with the view's own sample grid the buffer covers what holds a
+// texel's pixel centres. `pixels` pixel centres per texel side (the view is
+// kW × pixels by kH × pixels); `samples` as View::samples.
+struct Sampled {
+  View view;
+  OcclusionBuffer buffer;
+  explicit Sampled(int pixels, const OcclusionRules& rules = {}, int samples = 1, int extra_width = 0)
+      : view(make_view(CameraPose{}, Lens{60.0f, 0.1f, 100.0f}, kW * pixels + extra_width, kH * pixels)),
+        buffer(kW, kH, SimdPath::best, rules) {
+    view.samples = samples;
+    buffer.clear(view);
+  }
+  void draw(const Polys& p) {
+    const OccluderMesh mesh = make_occluder_mesh(p.positions, p.indices);
+    (void)buffer.rasterize(p.positions, mesh, mesh.polygons(), glm::dmat4(view.view_proj));
+  }
+  bool hidden(const Aabb& b) { return buffer.occluded(b, view.view_proj); }
+};
+
+// Two occluders meeting at a seam between texel 5's centre (5.5) and texel
+// 6's (6.5), 0.02 texel apart: with one pixel per texel no fragment can come
+// through, and a box behind texel 5 is hidden; with whole texels neither
+// occluder covers texel 5 (a seam of lost occlusion, rule 3).
+Polys seam() {
+  Polys p;
+  p.rect(-2.0f, 5.6f, -2.0f, 11.0f, 5.0f);
+  p.rect(5.62f, 18.0f, -2.0f, 11.0f, 5.0f);
+  return p;
+}
+
+TEST(OcclusionBufferSamples, ASeamHoldingNoPixelCentreHidesWhatIsBehindIt) {
+  const Aabb behind = box(5.3f, 5.9f, 3.2f, 3.8f, 10.0f);
+  Sampled sampled(1);
+  ASSERT_EQ(sampled.buffer.pixels_per_texel(), 1);
+  sampled.draw(seam());
+  EXPECT_EQ(sampled.buffer.covered_texels(), std::size_t(kW * kH));
+  EXPECT_TRUE(sampled.hidden(behind));
+  Fixture whole;  // cleared with clip conventions only: whole texels
+  EXPECT_EQ(whole.buffer.pixels_per_texel(), 0);
+  whole.draw(seam());
+  EXPECT_FALSE(whole.hidden(behind));
+}
+
+TEST(OcclusionBufferSamples, SampleCoverageOnlyForTheViewsOwnSampleGrid) {
+  const Aabb behind = box(5.3f, 5.9f, 3.2f, 3.8f, 10.0f);
+  // MSAA (or unknown sampling): the seam holds samples off the pixel centres.
+  Sampled msaa(1, {}, 0);
+  EXPECT_EQ(msaa.buffer.pixels_per_texel(), 0);
+  msaa.draw(seam());
+  EXPECT_FALSE(msaa.hidden(behind));
+  // A view one pixel wider: its pixel centres do not fall on the texels'.
+  Sampled wider(1, {}, 1, 1);
+  EXPECT_EQ(wider.buffer.pixels_per_texel(), 0);
+  wider.draw(seam());
+  EXPECT_FALSE(wider.hidden(behind));
+  Sampled broken(1, {.sample_grid = false}, 0);
+  broken.draw(seam());
+  EXPECT_TRUE(broken.hidden(behind)) << "taken as single-sampled, the MSAA view's seam should hide it";
+}
+
+TEST(OcclusionBufferSamples, AGapHoldingAPixelCentreKeepsWhatIsBehindItVisible) {
+  Polys gap;  // texel 5's centre, 5.5, lies in the gap
+  gap.rect(-2.0f, 5.45f, -2.0f, 11.0f, 5.0f);
+  gap.rect(5.55f, 18.0f, -2.0f, 11.0f, 5.0f);
+  Sampled f(1);
+  f.draw(gap);
+  EXPECT_EQ(f.buffer.covered_texels(), std::size_t((kW - 1) * kH));
+  EXPECT_FALSE(f.hidden(box(5.3f, 5.7f, 3.2f, 3.8f, 10.0f)));
+  EXPECT_TRUE(f.hidden(box(6.3f, 6.7f, 3.2f, 3.8f, 10.0f)));
+}
+
+// Ten pixels per texel: an occluder over texel 3's pixel centres (3.05 to
+// 3.95) but not the whole texel (3.02 to 3.98) covers it; a box reaching the first pixel
+// centre of texel 4 (4.05) by less than its margin of 1/64 texel is visible.
+TEST(OcclusionBufferSamples, ATexelIsCoveredWhenItsPixelCentresAreAndABoxReachingAnUncoveredOneIsVisible) {
+  Polys column;
+  column.rect(3.02f, 3.98f, -2.0f, 11.0f, 5.0f);
+  Sampled f(10);
+  ASSERT_EQ(f.buffer.pixels_per_texel(), 10);
+  f.draw(column);
+  EXPECT_EQ(f.buffer.covered_texels(), std::size_t(kH));
+  EXPECT_TRUE(f.hidden(box(3.2f, 4.02f, 3.2f, 3.8f, 10.0f)));
+  const Aabb reaching = box(3.2f, 4.045f, 3.2f, 3.8f, 10.0f);
+  EXPECT_FALSE(f.hidden(reaching));
+  Sampled broken(10, {.outer_rectangle = false});
+  broken.draw(column);
+  EXPECT_TRUE(broken.hidden(reaching)) << "texels by their centres should leave texel 4 untested";
+  Fixture whole;
+  whole.draw(column);
+  EXPECT_EQ(whole.buffer.covered_texels(), 0u);
+}
+
 // Rule 1: an occluder between the eye and the near plane (0.1) is never drawn.
 TEST(OcclusionBuffer, AnOccluderInFrontOfTheNearPlaneHidesNothing) {
   const Aabb behind = box(3.2f, 4.7f, 2.2f, 3.6f, 10.0f);

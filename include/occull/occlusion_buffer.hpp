@@ -62,6 +62,23 @@
 //                                        (DepthTiesAreVisible)
 //  9. Reversed-Z: depths are compared as keys, larger farther (the window
 //     depth, negated with reversed-Z).  (ReversedZHidesWhatIsBehindOnly)
+// 10. Sample coverage, only for a view that says how it is sampled (cleared
+//     with clear(view)): when the view is single-sampled (View::samples ==
+//     1: a fragment is made only at a pixel's centre) and its size is the
+//     buffer's times a whole k on both axes, each texel holds k × k pixel
+//     centres, and no fragment can be made anywhere else. Rules 3–5 then
+//     apply to the square those centres span (the texel shrunk by half a
+//     pixel on every side: a point when k = 1) instead of the whole texel:
+//     covered when that square, grown by 1/64 texel, lies strictly inside
+//     every edge; its depth the farthest over it; a box tested over the
+//     texels whose square its grown rectangle reaches. A gap between two
+//     occluders that holds no pixel centre shows nothing (as on the GPU),
+//     so the seams of a mesh split into small polygons no longer lose a
+//     texel's width of occlusion each — they lose 1/64 px. Any other view
+//     (MSAA, another size, samples == 0) keeps whole texels.
+//                                        (SampleCoverageOnlyForTheViewsOwnSampleGrid,
+//                                         AGapHoldingAPixelCentreKeepsWhatIsBehindItVisible,
+//                                         ABoxReachingAnUncoveredPixelCentreIsVisible)
 // The buffer is hierarchical: each tile of 8×8 texels keeps its farthest
 // key (refreshed when a test reads a tile written since), and a box whose
 // nearest depth is behind a tile's farthest needs no texel of that tile
@@ -104,6 +121,7 @@ struct OcclusionRules {
   bool reaching_eye_visible = true; ///< rule 7; false: corners behind the eye or near plane dropped
   bool depth_margin = true;         ///< rule 8; false: hidden when the box's depth is not nearer (ties hidden)
   bool tiles = true;                ///< false: no tile shortcut, every texel read (the answers must not change)
+  bool sample_grid = true;          ///< rule 10; false: every view taken as single-sampled at width / buffer width
 };
 }  // namespace detail
 
@@ -168,8 +186,16 @@ class OcclusionBuffer {
   [[nodiscard]] SimdPath simd() const noexcept { return simd_; }
 
   /// Starts a frame: every texel empty (farthest), depths compared with the
-  /// conventions `clip` from now on.
+  /// conventions `clip` from now on, texels covered whole (rules 3–5: the
+  /// buffer knows nothing of how the image is sampled).
   void clear(const ClipSpace& clip);
+  /// Starts a frame for `view`: as clear(view.clip), and with sample
+  /// coverage (rule 10) when the view is single-sampled and its size is a
+  /// whole multiple of the buffer's on both axes.
+  void clear(const View& view);
+  /// Pixel centres per texel side sampled this frame (rule 10); 0: texels
+  /// are covered whole.
+  [[nodiscard]] int pixels_per_texel() const noexcept { return pixels_; }
 
   /// Rasterizes the triangles `indices` (3 per triangle) of `positions`,
   /// transformed by `object_to_clip` (view_proj * object transform), into
@@ -221,12 +247,17 @@ class OcclusionBuffer {
   void raster_clipped(const glm::dvec4* clip, int n, std::uint32_t& count);
   void raster_polygon(const glm::dvec3* v, int n, std::uint32_t& count);
   float tile_farthest(int tx, int ty);
+  /// Half the side of what a texel must have inside a polygon to be covered
+  /// (the texel, or with rule 10 its pixel centres' square), in texels.
+  [[nodiscard]] double covered_half_side() const noexcept;
 
   int width_, height_;
   int tiles_x_, tiles_y_;
   SimdPath simd_;
   detail::OcclusionRules rules_;
   ClipSpace clip_;
+  int pixels_ = 0;            // rule 10: pixel centres per texel side, 0: whole texels
+  std::int64_t inset_ = 0;    // rule 10: fixed-point steps from a texel's side to its centres' square
   std::vector<float> keys_;
   std::vector<float> tile_far_;
   std::vector<std::uint8_t> tile_dirty_;

@@ -207,10 +207,28 @@ OcclusionBuffer::OcclusionBuffer(int width, int height, SimdPath simd, const det
 
 void OcclusionBuffer::clear(const ClipSpace& clip) {
   clip_ = clip;
+  pixels_ = 0;
+  inset_ = 0;
   std::fill(keys_.begin(), keys_.end(), kInf);
   std::fill(tile_far_.begin(), tile_far_.end(), kInf);
   std::fill(tile_dirty_.begin(), tile_dirty_.end(), std::uint8_t{0});
 }
+
+void OcclusionBuffer::clear(const View& view) {
+  clear(view.clip);
+  // Rule 10: k × k pixel centres per texel, only where the view says it is
+  // sampled at its pixels' centres and its pixels tile the texels exactly.
+  const int k = view.width / width_;
+  const bool grid = k >= 1 && view.width == k * width_ && view.height == k * height_;
+  if (rules_.sample_grid ? (view.samples == 1 && grid) : true) {
+    pixels_ = std::max(k, 1);
+    // Half a pixel in from each side, rounded down to a fixed-point step (a
+    // smaller square: more conservative).
+    inset_ = kSub / (2 * std::int64_t(pixels_));
+  }
+}
+
+double OcclusionBuffer::covered_half_side() const noexcept { return 0.5 - double(inset_) / double(kSub); }
 
 std::size_t OcclusionBuffer::covered_texels() const noexcept {
   return std::size_t(std::count_if(keys_.begin(), keys_.end(), [](float k) { return k != kInf; }));
@@ -253,8 +271,9 @@ std::uint32_t OcclusionBuffer::rasterize(std::span<const glm::vec3> positions, c
   // buffer at the nearest view depth of its bounding sphere (a length at view
   // depth z spans at most f / z * sqrt(1 + tan^2) texels, f texels per unit
   // at unit depth, tan of the lens's half angles); and its area seen at its
-  // angle, which must hold a circle of half a texel (pi / 4 texels): a wall
-  // seen edge on along a street covers nothing.
+  // angle, which must hold the circle inscribed in what a texel needs
+  // covered (half a texel, pi / 4 texels; less with rule 10): a wall seen
+  // edge on along a street covers nothing.
   const glm::dmat3 m(object_to_world);
   const double flip = glm::determinant(m) < 0.0 ? -1.0 : 1.0;  // a mirroring transform turns the winding
   const glm::dvec3 eye = glm::dvec3(glm::inverse(glm::dmat4(object_to_world)) * glm::dvec4(glm::dvec3(view.eye), 1.0));
@@ -267,6 +286,7 @@ std::uint32_t OcclusionBuffer::rasterize(std::span<const glm::vec3> positions, c
   const double depth_offset = -to_eye[3][2];
   const double depth_stretch = glm::length(depth_axis);
   const double near = double(view.near);
+  const double half_side = covered_half_side(), circle = 3.14159 * half_side * half_side;
   std::uint32_t drawn = 0;
   for (std::size_t p = 0; p < count; ++p) {
     const OccluderMesh::Bounds& b = mesh.bounds[p];
@@ -275,9 +295,9 @@ std::uint32_t OcclusionBuffer::rasterize(std::span<const glm::vec3> positions, c
     const glm::dvec3 centre(b.centre);
     const double z = std::max(glm::dot(depth_axis, centre) + depth_offset - depth_stretch * double(b.radius), near);
     const double texels = per_unit / z;  // per object unit, at most
-    if (double(mesh.inradius[p]) * texels < 0.5) continue;
+    if (double(mesh.inradius[p]) * texels < half_side) continue;
     const double cosine = std::min(1.0, std::abs(side) / std::max(glm::length(eye - centre), 1e-30));
-    if (double(b.area) * cosine * texels * texels < 0.785) continue;
+    if (double(b.area) * cosine * texels * texels < circle) continue;
     raster_mesh_polygon(positions, mesh, p, object_to_clip, drawn);
   }
   return drawn;
@@ -388,9 +408,9 @@ void OcclusionBuffer::raster_polygon(const glm::dvec3* in, int n, std::uint32_t&
   if (snapped_area <= 0) return;  // degenerate once snapped
   const std::int64_t min_x = *std::min_element(X, X + n), max_x = *std::max_element(X, X + n);
   const std::int64_t min_y = *std::min_element(Y, Y + n), max_y = *std::max_element(Y, Y + n);
-  // A polygon narrower than a grown texel on either axis covers none (a
-  // shortcut: the edge functions would find none).
-  const std::int64_t reach = rules_.inner_coverage ? kSub + 2 * kGrow : 0;
+  // A polygon narrower than a grown texel (rule 10: its centres' square) on
+  // either axis covers none (a shortcut: the edge functions would find none).
+  const std::int64_t reach = rules_.inner_coverage ? kSub - 2 * inset_ + 2 * kGrow : 0;
   if (max_x - min_x < reach || max_y - min_y < reach) return;
   ++count;
   const auto texel_floor = [](std::int64_t f) { return floor_div(f, kSub); };
@@ -415,9 +435,9 @@ void OcclusionBuffer::raster_polygon(const glm::dvec3* in, int n, std::uint32_t&
     e.a = Y[i] - Y[j];
     e.b = X[j] - X[i];
     e.c = -(e.a * X[i] + e.b * Y[i]);
-    if (rules_.inner_coverage) {
-      e.ox = e.a > 0 ? -kGrow : kSub + kGrow;
-      e.oy = e.b > 0 ? -kGrow : kSub + kGrow;
+    if (rules_.inner_coverage) {  // the grown texel's (rule 10: centres' square's) corner
+      e.ox = e.a > 0 ? inset_ - kGrow : kSub - inset_ + kGrow;
+      e.oy = e.b > 0 ? inset_ - kGrow : kSub - inset_ + kGrow;
     } else {
       e.ox = e.oy = kSub / 2;  // the texel's centre (rule 3 broken)
     }
@@ -447,8 +467,9 @@ void OcclusionBuffer::raster_polygon(const glm::dvec3* in, int n, std::uint32_t&
   double fx = 0.5, fy = 0.5, bias = 0.0;
   float cap = kInf;
   if (rules_.farthest_depth) {
-    fx = gx > 0.0 ? 1.0 + kGrowTexels : -kGrowTexels;
-    fy = gy > 0.0 ? 1.0 + kGrowTexels : -kGrowTexels;
+    const double inset = double(inset_) / double(kSub);  // rule 10
+    fx = gx > 0.0 ? 1.0 - inset + kGrowTexels : inset - kGrowTexels;
+    fy = gy > 0.0 ? 1.0 - inset + kGrowTexels : inset - kGrowTexels;
     bias = std::ldexp(std::max(std::abs(z_far), std::abs(z_near)) + (z_far - z_near), -20) + off_plane;
     cap = float(z_far);
     if (double(cap) < z_far) cap = std::nextafter(cap, kInf);
@@ -522,7 +543,7 @@ std::size_t OcclusionBuffer::polygons_worth_rasterizing(const OccluderMesh& mesh
   const double stretch = std::max({glm::length(m[0]), glm::length(m[1]), glm::length(m[2])});
   const double depth = view.orthographic ? 1.0 : std::max(double(distance(view.eye, bounds)), double(view.near));
   const double texels_per_unit = stretch * lens.texels_per_unit * (1.0 + tan2) / depth;
-  return mesh.count_at_least(float(0.5 / texels_per_unit));
+  return mesh.count_at_least(float(covered_half_side() / texels_per_unit));
 }
 
 float OcclusionBuffer::tile_farthest(int tx, int ty) {
@@ -559,7 +580,15 @@ bool OcclusionBuffer::occluded(const Aabb& box, const glm::mat4& view_proj) {
   const auto texel = [](float v, int size) { return int(std::clamp(std::floor(v), -1.0f, float(size))); };
   constexpr float grow = float(kGrowTexels);
   int x0, x1, y0, y1;
-  if (rules_.outer_rectangle) {
+  if (rules_.outer_rectangle && inset_ > 0) {
+    // Rule 10: the texels whose centres' square [t + in, t + 1 - in] the grown rectangle reaches.
+    const float in = float(double(inset_) / double(kSub));
+    const auto last = [&](float v, int size) { return texel(v - in, size); };
+    const auto first = [&](float v, int size) { return int(std::clamp(std::ceil(v - 1.0f + in), -1.0f, float(size))); };
+    x0 = first(min_x - grow, width_), x1 = last(max_x + grow, width_);
+    y0 = first(min_y - grow, height_), y1 = last(max_y + grow, height_);
+    if (x0 > x1 || y0 > y1) return false;  // holds no pixel centre: not the buffer's to say (holds_no_sample)
+  } else if (rules_.outer_rectangle) {
     x0 = texel(min_x - grow, width_), x1 = texel(max_x + grow, width_);
     y0 = texel(min_y - grow, height_), y1 = texel(max_y + grow, height_);
   } else {  // texels whose centre lies in the rectangle (rule 5 broken)

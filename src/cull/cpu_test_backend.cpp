@@ -64,7 +64,7 @@ void CpuTestBackend::begin_frame(Backend& inner, const View& view) {
   const int scale = std::max(1, m.options.scale);
   const int w = std::max(1, view.width / scale), h = std::max(1, view.height / scale);
   if (!m.buffer || m.buffer->width() != w || m.buffer->height() != h) m.buffer.emplace(w, h, m.options.simd);
-  m.buffer->clear(view.clip);
+  m.buffer->clear(view);
   m.occluders.begin_frame(view, *m.buffer);
   m.counters = {};
   m.counters.buffer_texels = std::uint64_t(w) * std::uint64_t(h);

@@ -43,7 +43,7 @@ class SocCuller final : public Culler {
     FrameResult result;
     BufferCounters& counters = counters_ = {};
     OcclusionBuffer& buffer = buffer_for(view);
-    buffer.clear(view.clip);
+    buffer.clear(view);
     occluders_.begin_frame(view, buffer);
     counters.buffer_texels = std::uint64_t(buffer.width()) * std::uint64_t(buffer.height());
     queue_.clear();
