@@ -28,6 +28,7 @@ struct RasterArgs {
   int frames = 50;
   int repeat = 5;
   double detail = 8.0;  // as soc.detail
+  bool whole_texels = false;  // rules 3-5 over whole texels instead of pixel centres (rule 10)
 };
 
 struct Job {
@@ -64,8 +65,9 @@ int cmd_raster(const RasterArgs& a) {
                         make_occluder_mesh(scene.mesh(o.mesh).positions, scene.mesh(o.mesh).indices, a.detail));
 
   fmt::print("scene {}, path {}, {} frames spread over the path, best of {} timings each; one core; "
-             "SIMD: {}\n",
-             a.scene, path.name(), a.frames, a.repeat, simd_target_name());
+             "SIMD: {}; coverage: {}\n",
+             a.scene, path.name(), a.frames, a.repeat, simd_target_name(),
+             a.whole_texels ? "whole texels" : "pixel centres (a view of the buffer's size)");
   fmt::print("{:>10} {:>9} {:>9} {:>12} {:>12} {:>12} {:>12} {:>8}\n", "buffer", "submitted", "polygons", "simd ms", "scalar ms",
              "simd p/ms", "scalar p/ms", "ratio");
   using Clock = std::chrono::steady_clock;
@@ -79,6 +81,9 @@ int cmd_raster(const RasterArgs& a) {
       animate(scene, bundle.scripted, t);
       const View view = make_view(path.sample(t), bundle.lens, w, h);
       jobs.clear();
+      // The view is the buffer's size: sample coverage with one pixel a texel (rule 10), as soc has at scale 1.
+      const auto start_frame = [&](OcclusionBuffer& b) { a.whole_texels ? b.clear(view.clip) : b.clear(view); };
+      start_frame(best);
       for (const Object& o : scene.objects()) {
         const auto it = occluders.find(o.mesh);
         if (it == occluders.end() || o.removed || o.occluder == OccluderClass::never ||
@@ -93,7 +98,7 @@ int cmd_raster(const RasterArgs& a) {
         double fastest = 1e30;
         std::uint64_t drawn = 0;
         for (int r = 0; r < a.repeat; ++r) {
-          buffer->clear(view.clip);
+          start_frame(*buffer);
           drawn = 0;
           const auto start = Clock::now();
           for (const Job& j : jobs)
@@ -131,6 +136,9 @@ Command add_raster(CLI::App& app) {
   ra->add_option("--detail", a->detail, "as soc.detail: polygons below 1/detail of their mesh's largest "
                                             "inscribed circle left out (0: all)")
       ->capture_default_str();
+  ra->add_flag("--whole-texels", a->whole_texels,
+               "cover whole texels (as for an MSAA view) instead of the pixel centres of a single-sampled view of the "
+               "buffer's size");
   return [a] { return cmd_raster(*a); };
 }
 

@@ -292,6 +292,10 @@ std::uint32_t OcclusionBuffer::rasterize(std::span<const glm::vec3> positions, c
     const OccluderMesh::Bounds& b = mesh.bounds[p];
     const double side = flip * (glm::dot(glm::dvec3(b.normal), eye) - double(b.offset));
     if (rules_.front_faces_only && side <= 0.0) continue;
+    if (half_side <= 0.0) {  // rule 10, one pixel a texel: any polygon may hold a pixel centre
+      raster_mesh_polygon(positions, mesh, p, object_to_clip, drawn);
+      continue;
+    }
     const glm::dvec3 centre(b.centre);
     const double z = std::max(glm::dot(depth_axis, centre) + depth_offset - depth_stretch * double(b.radius), near);
     const double texels = per_unit / z;  // per object unit, at most
@@ -413,11 +417,18 @@ void OcclusionBuffer::raster_polygon(const glm::dvec3* in, int n, std::uint32_t&
   const std::int64_t reach = rules_.inner_coverage ? kSub - 2 * inset_ + 2 * kGrow : 0;
   if (max_x - min_x < reach || max_y - min_y < reach) return;
   ++count;
-  const auto texel_floor = [](std::int64_t f) { return floor_div(f, kSub); };
-  const int x_lo = int(std::max<std::int64_t>(0, texel_floor(min_x)));
-  const int x_hi = int(std::min<std::int64_t>(width_ - 1, texel_floor(max_x)));
-  const int y_lo = int(std::max<std::int64_t>(0, texel_floor(min_y)));
-  const int y_hi = int(std::min<std::int64_t>(height_ - 1, texel_floor(max_y)));
+  // The texels whose grown square (rule 10: their centres' square) fits in
+  // the polygon's bounding rectangle: no other can lie inside every edge
+  // (what lies inside every edge of a polygon lies inside the polygon). A
+  // shortcut: small polygons holding no such square stop here.
+  const std::int64_t near_side = rules_.inner_coverage ? inset_ - kGrow : 0;
+  const std::int64_t far_side = rules_.inner_coverage ? kSub - inset_ + kGrow : kSub;
+  const auto first = [&](std::int64_t lo) { return -floor_div(near_side - lo, kSub); };  // ceil((lo - near) / kSub)
+  const auto last = [&](std::int64_t hi) { return floor_div(hi - (rules_.inner_coverage ? far_side : 0), kSub); };
+  const int x_lo = int(std::max<std::int64_t>(0, rules_.inner_coverage ? first(min_x) : floor_div(min_x, kSub)));
+  const int x_hi = int(std::min<std::int64_t>(width_ - 1, last(max_x)));
+  const int y_lo = int(std::max<std::int64_t>(0, rules_.inner_coverage ? first(min_y) : floor_div(min_y, kSub)));
+  const int y_hi = int(std::min<std::int64_t>(height_ - 1, last(max_y)));
   if (x_lo > x_hi || y_lo > y_hi) return;
 
   // Edge i runs from vertex i to i+1; inside is A*x + B*y + C > 0. The
