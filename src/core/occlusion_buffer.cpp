@@ -340,13 +340,17 @@ void OcclusionBuffer::raster_clipped(const glm::dvec4* clip, int vertices, std::
   // viewport is dropped, and so is a back-facing one lying wholly beyond
   // the near plane (its orientation on screen is the sign of det[x y w] of
   // three corners when every w > 0; a polygon's corners are coplanar).
+  // A polygon inside every plane (most) skips the clipping loop, which would change nothing.
+  bool inside = true;
   {
     unsigned all_out = 0xf, crossing_near = 0;
     for (int i = 0; i < vertices; ++i) {
       const glm::dvec4& c = clip[i];
       all_out &= unsigned(c.x > c.w) | unsigned(c.x < -c.w) << 1 | unsigned(c.y > c.w) << 2 | unsigned(c.y < -c.w) << 3;
       crossing_near |= unsigned(!(distance(c, 0) >= 0.0) || !(c.w > 0.0));
+      for (int p = 1; p < kPlanes; ++p) inside &= distance(c, p) >= 0.0;
     }
+    inside &= !crossing_near;
     if (all_out != 0) return;
     if (!crossing_near && rules_.front_faces_only) {
       const glm::dvec3 a(clip[0].x, clip[0].y, clip[0].w), b(clip[1].x, clip[1].y, clip[1].w),
@@ -357,7 +361,7 @@ void OcclusionBuffer::raster_clipped(const glm::dvec4* clip, int vertices, std::
   glm::dvec4 poly[kMax], next[kMax];
   int n = vertices;
   std::copy(clip, clip + n, poly);
-  for (int p = 0; p < kPlanes; ++p) {
+  for (int p = 0; p < kPlanes && !inside; ++p) {
     double d[kMax];
     bool any_out = false, all_out = true;
     for (int i = 0; i < n; ++i) {
@@ -492,11 +496,15 @@ void OcclusionBuffer::raster_polygon(const glm::dvec3* in, int n, std::uint32_t&
   // s = 256 a, r linear in ty. The bound floor(N/D) (N = -r, D = s when s > 0;
   // N = r, D = -s when s < 0) is stepped from row to row exactly, quotient
   // and remainder, with no division per row.
+  // A polygon over a few texels (most, at one pixel a texel) is cheaper
+  // tested texel by texel: the same edge functions, no division.
+  constexpr int kFewTexels = 16;
+  const bool few = (x_hi - x_lo + 1) * (y_hi - y_lo + 1) <= kFewTexels;
   struct Bound {
     int side;  // +1: a lower bound (s > 0), -1: an upper bound (s < 0), 0: the edge is horizontal
     std::int64_t q, rem, dq, drem, d, r, dr;
   } bounds[kMax];
-  for (int k = 0; k < edge_count; ++k) {
+  for (int k = 0; k < edge_count && !few; ++k) {
     const Edge& e = edges[k];
     Bound& b = bounds[k];
     const std::int64_t s = e.a * kSub;
@@ -513,7 +521,19 @@ void OcclusionBuffer::raster_polygon(const glm::dvec3* in, int n, std::uint32_t&
   }
   for (int ty = y_lo; ty <= y_hi; ++ty) {
     std::int64_t lo = x_lo, hi = x_hi;
-    for (int k = 0; k < edge_count; ++k) {
+    if (few) {  // e(tx) = s*tx + r(ty) > 0 at every edge (>= 0 at centres), as the bounds below
+      lo = x_hi + 1, hi = x_lo - 1;
+      for (std::int64_t tx = x_lo; tx <= x_hi; ++tx) {
+        bool inside = true;
+        for (int k = 0; k < edge_count && inside; ++k) {
+          const Edge& e = edges[k];
+          const std::int64_t f = e.a * (tx * kSub + e.ox) + e.b * (std::int64_t(ty) * kSub + e.oy) + e.c;
+          inside = strict ? f > 0 : f >= 0;
+        }
+        if (inside) lo = std::min(lo, tx), hi = tx;
+      }
+    }
+    for (int k = 0; k < edge_count && !few; ++k) {
       Bound& b = bounds[k];
       if (b.side > 0) {  // covered where tx > N/D (>= at centres)
         lo = std::max(lo, strict ? b.q + 1 : b.q + (b.rem != 0));
