@@ -286,7 +286,7 @@ std::uint32_t OcclusionBuffer::rasterize(std::span<const glm::vec3> positions, c
   const double depth_offset = -to_eye[3][2];
   const double depth_stretch = glm::length(depth_axis);
   const double near = double(view.near);
-  const double half_side = covered_half_side(), circle = 3.14159 * half_side * half_side;
+  const double half_side = covered_half_side(), circle = 0.785 * 4.0 * half_side * half_side;  // pi/4 of the square
   std::uint32_t drawn = 0;
   for (std::size_t p = 0; p < count; ++p) {
     const OccluderMesh::Bounds& b = mesh.bounds[p];
