@@ -123,6 +123,21 @@ TEST(CpuTestBackend, ChcppWithTheFirstTestIssuesFewerQueriesAndDrawsTheSame) {
   EXPECT_LT(queries[1], queries[0]);
 }
 
+TEST(CpuTestBackend, TheQueryCullersCpuScaleSizesItsBuffer) {
+  const Scene scene = wall_scene();
+  const Bvh bvh = Bvh::build(scene);
+  for (const auto& [spec, width] : {std::pair{"chcpp:cpu_test=on", 80}, std::pair{"chcpp:cpu_test=on:cpu_scale=1", 320},
+                                    std::pair{"chc:cpu_test=on:cpu_scale=2", 160}}) {
+    ScriptedBackend device;
+    auto culler = make_culler(spec, {scene, bvh});
+    (void)culler->render_frame(camera(), device);
+    ASSERT_NE(culler->occlusion_buffer(), nullptr) << spec;
+    EXPECT_EQ(culler->occlusion_buffer()->width(), width) << spec;
+    // A single-sampled view of 320 x 180 pixels: the buffer covers its pixel centres (rule 10).
+    EXPECT_EQ(culler->occlusion_buffer()->pixels_per_texel(), 320 / width) << spec;
+  }
+}
+
 TEST(Soc, DrawsTheWallAndWhatIsInFrontOfItButNotWhatIsBehind) {
   const Scene scene = wall_scene();
   const Bvh bvh = Bvh::build(scene);

@@ -33,6 +33,10 @@ struct QueryOptions {
   /// before each query, and issue it only when the buffer cannot prove the
   /// boxes hidden (occull/cpu_test_backend.hpp).
   bool cpu_test = false;
+  /// The CPU test's buffer = viewport / cpu_scale on each axis; in [1, 64].
+  /// 1 at a single-sampled view covers pixel centres (the buffer's rule 10):
+  /// more hidden, more CPU.
+  int cpu_scale = 4;
 };
 
 /// The boxes a node's query draws.

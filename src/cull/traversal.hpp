@@ -280,7 +280,9 @@ inline void append_query_boxes(const SceneIndex& index, NodeId n, const QuerySha
 class CpuTestedCuller : public Culler, public Resumable {
  public:
   CpuTestedCuller(const SceneIndex& index, const QueryOptions& options)
-      : cpu_test_(options.cpu_test ? std::make_unique<CpuTestBackend>(index.scene) : nullptr) {}
+      : cpu_test_(options.cpu_test
+                      ? std::make_unique<CpuTestBackend>(index.scene, CpuTestBackend::Options{.scale = options.cpu_scale})
+                      : nullptr) {}
 
   FrameResult cull(const View& view, Backend& backend) final {
     if (!cpu_test_) return cull_frame(view, backend);
@@ -339,7 +341,9 @@ ConfigTable<Config>&& with_common_options(ConfigTable<Config>&& table, At at) {
                1 << 30, "subtrees with at most this many triangles count as leaves (0: off)")
       .flag("cpu_test", [at](auto& c) -> auto& { return std::invoke(at, c).cpu_test; },
             "ask a conservative CPU occlusion buffer of the occluders drawn so far before each query; issue it only "
-            "when the buffer cannot prove the boxes hidden (CpuTestBackend)");
+            "when the buffer cannot prove the boxes hidden (CpuTestBackend)")
+      .integer("cpu_scale", [at](auto& c) -> auto& { return std::invoke(at, c).cpu_scale; }, 1, 64,
+               "the CPU test's buffer = viewport / cpu_scale on each axis");
 }
 
 }  // namespace occull::detail
