@@ -3,6 +3,7 @@
 // the rule switched off, which must fail (hide a box that shows).
 #include "occull/depth_pyramid.hpp"
 
+#include <glm/gtc/constants.hpp>
 #include <glm/gtc/matrix_transform.hpp>
 #include <gtest/gtest.h>
 
@@ -93,9 +94,12 @@ TEST(DepthPyramid, LevelOneTooFineMissesAGap) {
 TEST(DepthPyramid, MoreTexelsAtAFinerLevelTestTighter) {
   // Pixels 3..8 in front of a wall that ends at pixel 12: two texels of
   // level 3 reach the gap beyond it, three of level 2 do not.
+  // (Rule 10 off: its octants, narrower, would hide the box at any count.)
   std::vector<float> image = wall(16, 1, 0.5f);
   for (int x = 12; x < 16; ++x) image[std::size_t(x)] = 1.0f;
-  const DepthPyramid pyramid(image, 16, 1, false);
+  PyramidRules whole_boxes;
+  whole_boxes.octants_tested = 0;
+  const DepthPyramid pyramid(image, 16, 1, false, whole_boxes);
   const Aabb box = over_pixels(3, 8, 0, 0, 0.7f, 0.8f);
   EXPECT_FALSE(pyramid.occluded(box, pixel_view(16, 1), kZeroToOne, 2));
   EXPECT_TRUE(pyramid.occluded(box, pixel_view(16, 1), kZeroToOne, 4));
@@ -148,9 +152,76 @@ TEST(DepthPyramid, BoxesReachingTheEyeAreVisible) {
   EXPECT_TRUE(DepthPyramid(image, w, h, false).occluded({{-0.3f, -0.3f, -5.0f}, {0.3f, 0.3f, -3.0f}}, proj, clip));
 }
 
+TEST(DepthPyramid, OnlyPixelCentresInTheRectangleCount) {
+  // A wall with a gap at pixel 5; a box reaching into pixel 5 short of its
+  // centre (5.5) makes no fragment there when the view is single-sampled.
+  std::vector<float> image = wall(8, 1, 0.5f);
+  image[5] = 1.0f;
+  const DepthPyramid pyramid(image, 8, 1, false);
+  const glm::mat4 vp = pixel_view(8, 1);
+  const Aabb short_of_the_centre{{2.2f, 0.2f, -0.8f}, {5.4f, 0.8f, -0.7f}};
+  EXPECT_TRUE(pyramid.occluded(short_of_the_centre, vp, kZeroToOne, 16, true));
+  EXPECT_FALSE(pyramid.occluded(short_of_the_centre, vp, kZeroToOne, 16, false)) << "whole pixels: pixel 5 is touched";
+  const Aabb over_the_centre{{2.2f, 0.2f, -0.8f}, {5.6f, 0.8f, -0.7f}};
+  EXPECT_FALSE(pyramid.occluded(over_the_centre, vp, kZeroToOne, 16, true));
+  // A box between two centres can make no fragment at all.
+  EXPECT_TRUE(pyramid.occluded({{5.6f, 0.2f, -0.2f}, {6.4f, 0.8f, -0.1f}}, vp, kZeroToOne, 16, true));
+}
+
+TEST(DepthPyramid, CentresAreAtHalfPixels) {
+  // A box over the gap's centre only: visible, unless centres are taken at
+  // whole coordinates (5 and 6 lie outside it).
+  std::vector<float> image = wall(8, 1, 0.5f);
+  image[5] = 1.0f;
+  const Aabb over_the_gap{{5.3f, 0.2f, -0.8f}, {5.7f, 0.8f, -0.7f}};
+  const glm::mat4 vp = pixel_view(8, 1);
+  EXPECT_FALSE(DepthPyramid(image, 8, 1, false).occluded(over_the_gap, vp, kZeroToOne, 16, true));
+  PyramidRules broken;
+  broken.centres_at_half = false;
+  EXPECT_TRUE(DepthPyramid(image, 8, 1, false, broken).occluded(over_the_gap, vp, kZeroToOne, 16, true))
+      << "centres at whole coordinates should have hidden it";
+}
+
+TEST(DepthPyramid, OctantsHideADeepBoxAtASlant) {
+  // Looking down -z (90 degrees, 64x64): a box from 2 to 10 units away, off
+  // to the right, spans columns 35..56, its far half (6..10 away) columns
+  // 35..40. In front of it: columns 36 and beyond at 1.9 units, column 35 at
+  // 5.9 (the box's points there are 8 or more away). Every point of the box
+  // is hidden, but its nearest depth (2 units) is in front of column 35's.
+  const int w = 64, h = 64;
+  const glm::mat4 proj = glm::perspectiveRH_ZO(glm::half_pi<float>(), 1.0f, 0.1f, 100.0f);
+  const auto depth_at = [&](float distance) {
+    const glm::vec4 c = proj * glm::vec4(0, 0, -distance, 1);
+    return c.z / c.w;
+  };
+  std::vector<float> image = wall(w, h, 1.0f);
+  for (int y = 0; y < h; ++y)
+    for (int x = 35; x < w; ++x) image[std::size_t(y * w + x)] = depth_at(x == 35 ? 5.9f : 1.9f);
+  const Aabb deep{{1.0f, -0.25f, -10.0f}, {1.5f, 0.25f, -2.0f}};
+  EXPECT_TRUE(DepthPyramid(image, w, h, false).occluded(deep, proj, kZeroToOne, 16));
+  PyramidRules whole_boxes;
+  whole_boxes.octants_tested = 0;
+  EXPECT_FALSE(DepthPyramid(image, w, h, false, whole_boxes).occluded(deep, proj, kZeroToOne, 16))
+      << "the whole box's nearest depth is in front of column 35";
+}
+
+TEST(DepthPyramid, EveryOctantIsTested) {
+  // A box over pixels 0..3 at depths 0.4..0.8 before a wall at 0.3, but for
+  // pixel (3, 3) at 0.5: only its near upper-right octant (the last) shows.
+  std::vector<float> image = wall(4, 4, 0.3f);
+  image[3 * 4 + 3] = 0.5f;
+  const Aabb box = over_pixels(0, 3, 0, 3, 0.4f, 0.8f);
+  EXPECT_FALSE(DepthPyramid(image, 4, 4, false).occluded(box, pixel_view(4, 4), kZeroToOne, 16));
+  PyramidRules broken;
+  broken.octants_tested = 7;
+  EXPECT_TRUE(DepthPyramid(image, 4, 4, false, broken).occluded(box, pixel_view(4, 4), kZeroToOne, 16))
+      << "skipping the last octant should have hidden it";
+}
+
 // Whatever the image, box and texels read: the pyramid hides a box only if
 // every pixel its rectangle touches is nearer than its nearest corner (a
-// brute force over level 0).
+// brute force over level 0); with pixel centres, every pixel whose centre
+// it holds.
 TEST(DepthPyramid, HidesOnlyWhatEveryTouchedPixelHides) {
   std::mt19937 rng(7);
   std::uniform_real_distribution<float> unit(0.0f, 1.0f);
@@ -167,10 +238,15 @@ TEST(DepthPyramid, HidesOnlyWhatEveryTouchedPixelHides) {
       const float near = unit(rng);
       const Aabb box{{x0, y0, -(near + 0.1f)}, {x0 + unit(rng) * float(w) / 2, y0 + unit(rng) * float(h) / 2, -near}};
       const int texels = 2 << (k % 4);  // 2, 4, 8, 16
-      if (!pyramid.occluded(box, vp, kZeroToOne, texels)) continue;
+      const bool centres = trial % 2 == 1;
+      if (!pyramid.occluded(box, vp, kZeroToOne, texels, centres)) continue;
       ++hidden;
-      for (int y = std::max(0, int(std::floor(box.min.y))); y <= std::min(h - 1, int(std::floor(box.max.y))); ++y)
-        for (int x = std::max(0, int(std::floor(box.min.x))); x <= std::min(w - 1, int(std::floor(box.max.x))); ++x)
+      const auto first = [&](float v) { return std::max(0, int(centres ? std::ceil(v - 0.5f) : std::floor(v))); };
+      const auto last = [&](float v, int size) {
+        return std::min(size - 1, int(centres ? std::floor(v - 0.5f) : std::floor(v)));
+      };
+      for (int y = first(box.min.y); y <= last(box.max.y, h); ++y)
+        for (int x = first(box.min.x); x <= last(box.max.x, w); ++x)
           ASSERT_LT(image[std::size_t(y) * std::size_t(w) + std::size_t(x)], near)
               << "trial " << trial << ": pixel " << x << "," << y << " shows the box";
     }

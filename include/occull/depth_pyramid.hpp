@@ -41,6 +41,20 @@
 //     ulps of the largest depth of its triangle).  (DepthTiesAreVisible)
 //  8. Reversed-Z: "farther" is smaller depth. Comparing as if it were
 //     standard depth turns every rule around.    (ReversedZComparesTheOtherWay)
+//  9. Pixel centres, for a single-sampled view whose size is level 0's (the
+//     caller says so: `pixel_centres`): a rasterizer makes a fragment only
+//     at a pixel whose centre (x + 1/2, y + 1/2) a primitive covers, so the
+//     rectangle of rule 3 is the pixels whose centre its widened rectangle
+//     holds (none: hidden, nothing can be drawn). Taking centres at whole
+//     coordinates shifts the rectangle half a pixel off the box.
+//                  (OnlyPixelCentresInTheRectangleCount, CentresAreAtHalfPixels)
+// 10. Octants: a box rules 3-9 cannot hide is cut at its centre into its 8
+//     octants, each tested by rules 3-9 on its own, and is hidden when every
+//     octant is (their union is the box). Each octant's rectangle is smaller
+//     and its nearest depth its own, so a deep box seen at a slant (along a
+//     road, up a slope) is no longer tested at its nearest depth everywhere.
+//     Skipping an octant hides what shows through it alone.
+//                          (OctantsHideADeepBoxAtASlant, EveryOctantIsTested)
 // Outside those rules a box is visible: an empty box, or a rectangle that
 // falls entirely off the image, is reported hidden only because nothing of it
 // can be drawn (the frustum test in front of the pyramid normally culls it).
@@ -67,6 +81,8 @@ struct PyramidRules {
   bool reaching_eye_visible = true;///< rule 6; false: corners behind the eye or near plane dropped
   bool reversed_aware = true;      ///< rule 8; false: reversed-Z depth compared as standard
   bool depth_margin = true;        ///< rule 7; false: occluded when the box's depth is not nearer (ties hidden)
+  bool centres_at_half = true;     ///< rule 9; false: pixel centres taken at whole coordinates
+  int octants_tested = 8;          ///< rule 10; 7: the last octant skipped; 0: no octants
 };
 }  // namespace detail
 
@@ -121,9 +137,12 @@ class DepthPyramid {
   /// must be the pyramid's). False means "may be visible". The test reads
   /// at most `texels` × `texels` texels (2, 4, 8 or 16), at the level where the
   /// box's rectangle spans that many: log2(texels / 2) levels finer than
-  /// rule 4's, a tighter test for more reads.
+  /// rule 4's, a tighter test for more reads. `pixel_centres`: the view is
+  /// single-sampled and of level 0's size, so only pixel centres can receive
+  /// fragments (rule 9); false for MSAA or another size. A box the whole-box
+  /// test cannot hide is tested octant by octant (rule 10): up to 9 tests.
   [[nodiscard]] bool occluded(const Aabb& box, const glm::mat4& view_proj, const ClipSpace& clip,
-                              int texels = 2) const;
+                              int texels = 2, bool pixel_centres = false) const;
 
  private:
   struct Level {
@@ -132,6 +151,9 @@ class DepthPyramid {
   };
   // Larger is farther: depth, or -depth with reversed-Z (unless broken).
   [[nodiscard]] float key(float depth) const noexcept { return reversed_ && rules_.reversed_aware ? -depth : depth; }
+  // Rules 3-9 for one box (a whole box, or an octant of one).
+  [[nodiscard]] bool whole_box_occluded(const Aabb& box, const glm::mat4& view_proj, const ClipSpace& clip,
+                                        int texels, bool pixel_centres) const;
   std::vector<Level> levels_;
   bool reversed_ = false;
   detail::PyramidRules rules_;

@@ -11,7 +11,8 @@
 //     one frame and read by the next;
 //   - the frame's depth buffer as something a compute pass can read, and a
 //     depth pyramid built from it (each texel the farthest depth of the
-//     texels below it; see occull/depth_pyramid.hpp for the test's rules);
+//     texels below it; see occull/depth_pyramid.hpp for the test's rules,
+//     all ten: rule 9 for a single-sampled view of the target's size);
 //   - indirect draws whose commands the device writes (no per-object work on
 //     the CPU).
 // An engine's backend offers it by returning itself (or a helper) from

@@ -85,10 +85,31 @@ float DepthPyramid::at(int level, int x, int y) const {
   return l.texels.at(std::size_t(y) * std::size_t(l.width) + std::size_t(x));
 }
 
-bool DepthPyramid::occluded(const Aabb& box, const glm::mat4& view_proj, const ClipSpace& clip, int texels) const {
+bool DepthPyramid::occluded(const Aabb& box, const glm::mat4& view_proj, const ClipSpace& clip, int texels,
+                            bool pixel_centres) const {
   if (texels != 2 && texels != 4 && texels != 8 && texels != 16)
     throw UsageError(detail::format("DepthPyramid::occluded: {} texels per axis (2, 4, 8 or 16)", texels));
   if (box.empty()) return true;  // nothing to draw
+  if (whole_box_occluded(box, view_proj, clip, texels, pixel_centres)) return true;
+  if (rules_.octants_tested == 0) return false;
+  // Rule 10: the box is the union of its octants; hidden when each is.
+  // (The order changes nothing but how soon a visible box is known: the
+  // device's shader starts with the octant nearest the eye.)
+  const glm::vec3 mid = box.center();
+  for (int o = 0; o < rules_.octants_tested; ++o) {
+    Aabb part;
+    for (int axis = 0; axis < 3; ++axis) {
+      const bool upper = (o >> axis & 1) != 0;
+      part.min[axis] = upper ? mid[axis] : box.min[axis];
+      part.max[axis] = upper ? box.max[axis] : mid[axis];
+    }
+    if (!whole_box_occluded(part, view_proj, clip, texels, pixel_centres)) return false;
+  }
+  return true;
+}
+
+bool DepthPyramid::whole_box_occluded(const Aabb& box, const glm::mat4& view_proj, const ClipSpace& clip, int texels,
+                                      bool pixel_centres) const {
   const Level& base = levels_.front();
   const BoxFootprint f = project_box(box, view_proj, clip, base.width, base.height);
   if (f.reaches_eye && rules_.reaching_eye_visible) return false;  // rule 6
@@ -102,11 +123,23 @@ bool DepthPyramid::occluded(const Aabb& box, const glm::mat4& view_proj, const C
   // (Clamped as floats first: a corner just in front of the eye projects
   // far off the image, past what an int holds.)
   const auto pixel = [](float v, int size) { return int(std::clamp(std::floor(v), -1.0f, float(size))); };
-  const int x0 = std::max(0, pixel(min_x - margin, base.width));
-  const int y0 = std::max(0, pixel(min_y - margin, base.height));
-  const int x1 = std::min(base.width - 1, pixel(max_x + margin, base.width));
-  const int y1 = std::min(base.height - 1, pixel(max_y + margin, base.height));
-  if (x0 > x1 || y0 > y1) return true;  // off the image: nothing to draw
+  int x0 = pixel(min_x - margin, base.width), y0 = pixel(min_y - margin, base.height);
+  int x1 = pixel(max_x + margin, base.width), y1 = pixel(max_y + margin, base.height);
+  if (pixel_centres) {
+    // Rule 9: only pixels whose centre (x + 1/2, y + 1/2) the widened
+    // rectangle holds can receive a fragment.
+    const float centre = rules_.centres_at_half ? 0.5f : 0.0f;
+    const auto first = [&](float v, int size) { return int(std::clamp(std::ceil(v - centre), -1.0f, float(size))); };
+    x0 = first(min_x - margin, base.width);
+    y0 = first(min_y - margin, base.height);
+    x1 = pixel(max_x + margin - centre, base.width);
+    y1 = pixel(max_y + margin - centre, base.height);
+  }
+  x0 = std::max(0, x0);
+  y0 = std::max(0, y0);
+  x1 = std::min(base.width - 1, x1);
+  y1 = std::min(base.height - 1, y1);
+  if (x0 > x1 || y0 > y1) return true;  // off the image, or no pixel centre: nothing to draw
   // Rule 4: the level where the rectangle spans at most texels × texels.
   const int extent = std::max(x1 - x0 + 1, y1 - y0 + 1);
   int level = rules_.ceil_level ? pyramid_level_for(extent) : std::bit_width(unsigned(extent)) - 1;

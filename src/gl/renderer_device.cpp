@@ -134,7 +134,8 @@ float level_texel(int level, ivec2 p) {
   return level == 0 ? texelFetch(u_depth, p, 0).r : texelFetch(u_pyramid, p, level - 1).r;
 }
 
-bool occluded(vec3 lo, vec3 hi) {
+// Rules 3-9 of occull/depth_pyramid.hpp for one box.
+bool whole_box_occluded(vec3 lo, vec3 hi) {
   vec2 rmin = vec2(1e30), rmax = vec2(-1e30);
   float nearest = 1e30;
   for (int i = 0; i < 8; ++i) {
@@ -151,8 +152,12 @@ bool occluded(vec3 lo, vec3 hi) {
   }
   const float margin = 1.0 / 64.0;
   ivec2 size0 = u_level_size[0];
-  ivec2 p0 = ivec2(clamp(floor(rmin - margin), vec2(-1.0), vec2(size0)));
-  ivec2 p1 = ivec2(clamp(floor(rmax + margin), vec2(-1.0), vec2(size0)));
+  // Rule 9: with one sample at each pixel's centre, only the pixels whose
+  // centre the widened rectangle holds.
+  float centre = u_subpixel ? 0.5 : 0.0;
+  vec2 first = u_subpixel ? ceil(rmin - margin - centre) : floor(rmin - margin);
+  ivec2 p0 = ivec2(clamp(first, vec2(-1.0), vec2(size0)));
+  ivec2 p1 = ivec2(clamp(floor(rmax + margin - centre), vec2(-1.0), vec2(size0)));
   p0 = max(p0, ivec2(0));
   p1 = min(p1, size0 - 1);
   if (p0.x > p1.x || p0.y > p1.y) return true;  // off the image
@@ -165,6 +170,21 @@ bool occluded(vec3 lo, vec3 hi) {
   for (int y = t0.y; y <= t1.y; ++y)
     for (int x = t0.x; x <= t1.x; ++x) farthest = max(farthest, key(level_texel(level, ivec2(x, y))));
   return nearest > farthest + (4e-6 * abs(farthest) + 4e-7);
+}
+
+// Rule 10: a box rules 3-9 cannot hide, octant by octant, the one nearest
+// the eye first.
+bool occluded(vec3 lo, vec3 hi) {
+  if (whole_box_occluded(lo, hi)) return true;
+  vec3 mid = 0.5 * (lo + hi);
+  bvec3 eye_upper = greaterThan(u_eye, mid);
+  int nearest = (eye_upper.x ? 1 : 0) | (eye_upper.y ? 2 : 0) | (eye_upper.z ? 4 : 0);
+  for (int i = 0; i < 8; ++i) {
+    int o = i ^ nearest;
+    bvec3 upper = bvec3((o & 1) != 0, (o & 2) != 0, (o & 4) != 0);
+    if (!whole_box_occluded(mix(lo, mid, upper), mix(mid, hi, upper))) return false;
+  }
+  return true;
 }
 
 void emit(uint region, uint i, DeviceObject o, bool draw) {
