@@ -18,7 +18,12 @@ using namespace occull;
 
 namespace {
 
+// Half as many under the sanitizers (tests/CMakeLists.txt).
+#ifdef OCCULL_TEST_SANITIZED
+constexpr int kFrames = 12;
+#else
 constexpr int kFrames = 24;
+#endif
 // Bounded in what they draw over the attacks' walks but for nohc and auto
 // (they may decide by cost to draw without queries) and chcpp with its
 // virtual leaves of 1,500 triangles: a leaf holds a hundred of these small
