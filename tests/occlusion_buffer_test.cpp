@@ -452,3 +452,48 @@ TEST(OcclusionBuffer, SimdMatchesScalar) {
   EXPECT_GE(hidden_answers, 50);  // both answers came up
   EXPECT_FALSE(simd_target_name().empty());
 }
+
+// A mesh's polygons share their corners' transform and projection (each
+// vertex of a call done once): the keys are those of rasterizing its
+// triangles one by one, bit for bit, and a second call with another matrix
+// transforms afresh. A bumpy terrain reaching behind the eye (clipped at the
+// near plane), no two triangles coplanar (no quads), at whole texels and at
+// pixel centres.
+TEST(OcclusionBuffer, SharedVerticesRasterizeAsSeparateTriangles) {
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<float> bump(-1.0f, 1.0f);
+  constexpr int kSide = 24;
+  std::vector<glm::vec3> pos;
+  std::vector<std::uint32_t> idx;
+  for (int z = 0; z < kSide; ++z)
+    for (int x = 0; x < kSide; ++x)
+      pos.emplace_back(-60.0f + 5.0f * float(x), -2.0f + 0.6f * bump(rng), 5.0f - 5.0f * float(z));
+  for (int z = 0; z + 1 < kSide; ++z)
+    for (int x = 0; x + 1 < kSide; ++x) {
+      const auto v = std::uint32_t(z * kSide + x);
+      // Counter-clockwise seen from above (+y): the terrain faces the sky.
+      idx.insert(idx.end(), {v, v + 1, v + kSide, v + 1, v + kSide + 1, v + kSide});
+    }
+  const OccluderMesh mesh = make_occluder_mesh(pos, idx);
+  ASSERT_EQ(mesh.polygons(), idx.size() / 3);  // no quad merged
+  ASSERT_TRUE(mesh.shared_corners);
+  const View view = camera();
+  const glm::dmat4 moved = glm::dmat4(view.view_proj) * glm::dmat4(glm::mat4{1.0f, 0.0f, 0.0f, 0.0f,  //
+                                                                             0.0f, 1.0f, 0.0f, 0.0f,  //
+                                                                             0.0f, 0.0f, 1.0f, 0.0f,  //
+                                                                             3.0f, -1.5f, -4.0f, 1.0f});
+  for (const int size : {1, 10}) {  // texels of 10 × 10 pixels, covered whole; one pixel each, at its centre
+    OcclusionBuffer shared(160 / size, 90 / size), one_by_one(160 / size, 90 / size);
+    for (OcclusionBuffer* b : {&shared, &one_by_one}) size == 1 ? b->clear(view) : b->clear(view.clip);
+    std::uint32_t polygons = 0, triangles = 0;
+    for (const glm::dmat4& m : {glm::dmat4(view.view_proj), moved}) {
+      polygons += shared.rasterize(pos, mesh, mesh.polygons(), m);
+      triangles += one_by_one.rasterize(pos, idx, m);
+    }
+    EXPECT_EQ(polygons, triangles);
+    EXPECT_GT(shared.covered_texels(), shared.keys().size() / 16) << size;  // the comparison compares something
+    for (std::size_t i = 0; i < shared.keys().size(); ++i)
+      ASSERT_EQ(std::bit_cast<std::uint32_t>(shared.keys()[i]), std::bit_cast<std::uint32_t>(one_by_one.keys()[i]))
+          << "buffer " << shared.width() << "x" << shared.height() << " texel " << i;
+  }
+}

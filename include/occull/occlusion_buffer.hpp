@@ -155,6 +155,10 @@ struct OccluderMesh {
     float area;  ///< object units squared
   };
   std::vector<Bounds> bounds;
+  /// Whether its polygons share corners (at least 2 corners a vertex, as a
+  /// terrain's or a smooth mesh's do, not a flat-shaded box's): then each
+  /// vertex is transformed and projected once a call, not once a corner.
+  bool shared_corners = false;
   [[nodiscard]] std::size_t polygons() const noexcept { return inradius.size(); }
   /// How many leading polygons have an inradius of at least `radius`.
   [[nodiscard]] std::size_t count_at_least(float radius) const noexcept;
@@ -242,10 +246,31 @@ class OcclusionBuffer {
   [[nodiscard]] std::size_t covered_texels() const noexcept;
 
  private:
+  /// A vertex in clip space, where it lies against the clip planes, and
+  /// (once a polygon in front of the near plane needs them) its texel
+  /// coordinates, depth key and snapped coordinates: what every polygon at
+  /// that corner needs of it.
+  struct ClipVertex {
+    glm::dvec4 clip;
+    glm::dvec3 window;     // texel x, y and the depth key; when projected
+    std::int64_t x, y;     // window x, y snapped to 1/256 texel; when projected
+    unsigned outside;      // bits: beyond x = w, x = -w, y = w, y = -w
+    bool crossing_near;    // behind the near plane, or w <= 0
+    bool inside;           // inside the near plane and the guard band
+    bool projected;        // window, x and y are set
+  };
+  [[nodiscard]] ClipVertex classify(const glm::dvec4& clip) const;
+  /// Sets v's window, x and y if not yet. Precondition: !v.crossing_near.
+  void project_once(ClipVertex& v) const;
+  [[nodiscard]] glm::dvec3 project(const glm::dvec4& clip) const;
+  /// Starts a call rasterizing polygons of `vertices` positions: no vertex
+  /// transformed yet.
+  void begin_vertices(std::size_t vertices);
   void raster_mesh_polygon(std::span<const glm::vec3> positions, const OccluderMesh& mesh, std::size_t p,
                            const glm::dmat4& object_to_clip, std::uint32_t& count);
-  void raster_clipped(const glm::dvec4* clip, int n, std::uint32_t& count);
+  void raster_clipped(ClipVertex* const* v, int n, std::uint32_t& count);
   void raster_polygon(const glm::dvec3* v, int n, std::uint32_t& count);
+  void raster_snapped(const glm::dvec3* v, const std::int64_t* X, const std::int64_t* Y, int n, std::uint32_t& count);
   float tile_farthest(int tx, int ty);
   /// Half the side of what a texel must have inside a polygon to be covered
   /// (the texel, or with rule 10 its pixel centres' square), in texels.
@@ -261,6 +286,11 @@ class OcclusionBuffer {
   std::vector<float> keys_;
   std::vector<float> tile_far_;
   std::vector<std::uint8_t> tile_dirty_;
+  // Each vertex of the mesh being rasterized, transformed and projected once
+  // however many polygons share it: valid where its stamp is stamp_.
+  std::vector<ClipVertex> vertices_;
+  std::vector<std::uint32_t> vertex_stamp_;
+  std::uint32_t stamp_ = 0;
 };
 
 }  // namespace occull

@@ -188,6 +188,12 @@ OccluderMesh make_occluder_mesh(std::span<const glm::vec3> positions, std::span<
     out.inradius.push_back(p.radius);
     out.bounds.push_back(p.bounds);
   }
+  std::vector<std::uint32_t> used(out.corners);
+  std::erase(used, OccluderMesh::no_corner);
+  const std::size_t corners = used.size();
+  std::sort(used.begin(), used.end());
+  used.erase(std::unique(used.begin(), used.end()), used.end());
+  out.shared_corners = corners >= 2 * used.size() && !used.empty();
   return out;
 }
 
@@ -238,14 +244,15 @@ std::uint32_t OcclusionBuffer::rasterize(std::span<const glm::vec3> positions, s
                                          const glm::dmat4& object_to_clip) {
   std::uint32_t count = 0;
   for (std::size_t i = 0; i + 2 < indices.size(); i += 3) {
-    glm::dvec4 c[3];
+    ClipVertex c[3];
     for (int k = 0; k < 3; ++k) {
       if (indices[i + std::size_t(k)] >= positions.size())
         throw UsageError(detail::format("OcclusionBuffer::rasterize: index {} of {} positions",
                                         indices[i + std::size_t(k)], positions.size()));
-      c[k] = object_to_clip * glm::dvec4(glm::dvec3(positions[indices[i + std::size_t(k)]]), 1.0);
+      c[k] = classify(object_to_clip * glm::dvec4(glm::dvec3(positions[indices[i + std::size_t(k)]]), 1.0));
     }
-    raster_clipped(c, 3, count);
+    ClipVertex* v[3] = {&c[0], &c[1], &c[2]};
+    raster_clipped(v, 3, count);
   }
   return count;
 }
@@ -255,9 +262,8 @@ std::uint32_t OcclusionBuffer::rasterize(std::span<const glm::vec3> positions, c
   if (count > mesh.polygons())
     throw UsageError(detail::format("OcclusionBuffer::rasterize: {} polygons of a mesh of {}", count, mesh.polygons()));
   std::uint32_t drawn = 0;
-  for (std::size_t p = 0; p < count; ++p) {
-    raster_mesh_polygon(positions, mesh, p, object_to_clip, drawn);
-  }
+  if (mesh.shared_corners) begin_vertices(positions.size());
+  for (std::size_t p = 0; p < count; ++p) raster_mesh_polygon(positions, mesh, p, object_to_clip, drawn);
   return drawn;
 }
 
@@ -288,6 +294,7 @@ std::uint32_t OcclusionBuffer::rasterize(std::span<const glm::vec3> positions, c
   const double near = double(view.near);
   const double half_side = covered_half_side(), circle = 0.785 * 4.0 * half_side * half_side;  // pi/4 of the square
   std::uint32_t drawn = 0;
+  if (mesh.shared_corners) begin_vertices(positions.size());
   for (std::size_t p = 0; p < count; ++p) {
     const OccluderMesh::Bounds& b = mesh.bounds[p];
     const double side = flip * (glm::dot(glm::dvec3(b.normal), eye) - double(b.offset));
@@ -307,21 +314,84 @@ std::uint32_t OcclusionBuffer::rasterize(std::span<const glm::vec3> positions, c
   return drawn;
 }
 
+void OcclusionBuffer::begin_vertices(std::size_t vertices) {
+  if (vertex_stamp_.size() < vertices) {
+    vertex_stamp_.resize(vertices, 0);
+    vertices_.resize(vertices);
+  }
+  if (++stamp_ == 0) {  // wrapped: no stamp may look current
+    std::fill(vertex_stamp_.begin(), vertex_stamp_.end(), 0u);
+    stamp_ = 1;
+  }
+}
+
 void OcclusionBuffer::raster_mesh_polygon(std::span<const glm::vec3> positions, const OccluderMesh& mesh,
                                           std::size_t p, const glm::dmat4& object_to_clip, std::uint32_t& count) {
   const std::uint32_t* corners = mesh.corners.data() + 4 * p;
   const int n = corners[3] == OccluderMesh::no_corner ? 3 : 4;
-  glm::dvec4 c[4];
-  for (int k = 0; k < n; ++k) c[k] = object_to_clip * glm::dvec4(glm::dvec3(positions[corners[k]]), 1.0);
-  raster_clipped(c, n, count);
+  ClipVertex* v[4];
+  if (!mesh.shared_corners) {  // each corner its own vertex: nothing to share
+    ClipVertex c[4];
+    for (int k = 0; k < n; ++k) {
+      c[k] = classify(object_to_clip * glm::dvec4(glm::dvec3(positions[corners[k]]), 1.0));
+      v[k] = &c[k];
+    }
+    raster_clipped(v, n, count);
+    return;
+  }
+  for (int k = 0; k < n; ++k) {
+    const std::uint32_t i = corners[k];
+    if (vertex_stamp_[i] != stamp_) {
+      vertices_[i] = classify(object_to_clip * glm::dvec4(glm::dvec3(positions[i]), 1.0));
+      vertex_stamp_[i] = stamp_;
+    }
+    v[k] = &vertices_[i];
+  }
+  raster_clipped(v, n, count);
+}
+
+namespace {
+// Every coordinate of a clipped vertex lies within 2^19 texels of the
+// buffer: 2^27 fixed-point steps, so edge functions stay within int64.
+double guard_band(int width, int height) { return double(1 << 20) / double(std::max(width, height)) - 1.0; }
+constexpr int kPlanes = 5;  // the near plane, then the guard band's four sides
+}  // namespace
+
+// Texel coordinates and the depth key (window depth, negated with reversed-Z)
+// of a point in front of the near plane.
+glm::dvec3 OcclusionBuffer::project(const glm::dvec4& c) const {
+  const double ndc_z = c.z / c.w;
+  const double depth = clip_.depth == DepthRange::zero_to_one ? ndc_z : ndc_z * 0.5 + 0.5;
+  return {(c.x / c.w * 0.5 + 0.5) * double(width_), (c.y / c.w * 0.5 + 0.5) * double(height_),
+          clip_.reversed_z ? -depth : depth};
+}
+
+OcclusionBuffer::ClipVertex OcclusionBuffer::classify(const glm::dvec4& c) const {
+  const double guard = guard_band(width_, height_);
+  ClipVertex out{};
+  out.clip = c;
+  out.outside = unsigned(c.x > c.w) | unsigned(c.x < -c.w) << 1 | unsigned(c.y > c.w) << 2 | unsigned(c.y < -c.w) << 3;
+  const double near = !rules_.clip_near ? c.w - 1e-5
+                      : clip_.reversed_z ? c.w - c.z
+                                         : c.z - clip_.near_depth() * c.w;
+  out.crossing_near = !(near >= 0.0) || !(c.w > 0.0);
+  out.inside = !out.crossing_near && guard * c.w - c.x >= 0.0 && guard * c.w + c.x >= 0.0 &&
+               guard * c.w - c.y >= 0.0 && guard * c.w + c.y >= 0.0;
+  return out;
+}
+
+void OcclusionBuffer::project_once(ClipVertex& v) const {
+  if (v.projected) return;
+  v.window = project(v.clip);
+  v.x = snap(v.window.x);
+  v.y = snap(v.window.y);
+  v.projected = true;
 }
 
 // Rule 1: clips a convex polygon at the near plane and the guard band (in
 // double, Sutherland-Hodgman), then rasterizes what is left.
-void OcclusionBuffer::raster_clipped(const glm::dvec4* clip, int vertices, std::uint32_t& count) {
-  // Every coordinate of a clipped vertex lies within 2^19 texels of the
-  // buffer: 2^27 fixed-point steps, so edge functions stay within int64.
-  const double guard = double(1 << 20) / double(std::max(width_, height_)) - 1.0;
+void OcclusionBuffer::raster_clipped(ClipVertex* const* v, int vertices, std::uint32_t& count) {
+  const double guard = guard_band(width_, height_);
   const double near_depth = clip_.near_depth();
   const auto distance = [&](const glm::dvec4& c, int plane) -> double {
     switch (plane) {
@@ -334,42 +404,52 @@ void OcclusionBuffer::raster_clipped(const glm::dvec4* clip, int vertices, std::
       default: return guard * c.w + c.y;
     }
   };
-  constexpr int kPlanes = 5;
   constexpr int kMax = 4 + kPlanes;
   // Shortcuts that change no texel: a polygon wholly past one side of the
   // viewport is dropped, and so is a back-facing one lying wholly beyond
   // the near plane (its orientation on screen is the sign of det[x y w] of
   // three corners when every w > 0; a polygon's corners are coplanar).
-  // A polygon inside every plane (most) skips the clipping loop, which would change nothing.
-  bool inside = true;
-  {
-    unsigned all_out = 0xf, crossing_near = 0;
+  unsigned all_out = 0xf;
+  bool crossing_near = false, inside = true;
+  for (int i = 0; i < vertices; ++i) {
+    all_out &= v[i]->outside;
+    crossing_near |= v[i]->crossing_near;
+    inside &= v[i]->inside;
+  }
+  if (all_out != 0) return;
+  if (!crossing_near && rules_.front_faces_only) {
+    const glm::dvec3 a(v[0]->clip.x, v[0]->clip.y, v[0]->clip.w), b(v[1]->clip.x, v[1]->clip.y, v[1]->clip.w),
+        c(v[2]->clip.x, v[2]->clip.y, v[2]->clip.w);
+    if (!(glm::dot(a, glm::cross(b, c)) > 0.0)) return;
+  }
+  glm::dvec3 s[kMax];
+  if (inside) {  // most: no plane to clip at, and the corners are projected and snapped already
+    std::int64_t X[4], Y[4];
     for (int i = 0; i < vertices; ++i) {
-      const glm::dvec4& c = clip[i];
-      all_out &= unsigned(c.x > c.w) | unsigned(c.x < -c.w) << 1 | unsigned(c.y > c.w) << 2 | unsigned(c.y < -c.w) << 3;
-      crossing_near |= unsigned(!(distance(c, 0) >= 0.0) || !(c.w > 0.0));
-      for (int p = 1; p < kPlanes; ++p) inside &= distance(c, p) >= 0.0;
+      project_once(*v[i]);
+      s[i] = v[i]->window, X[i] = v[i]->x, Y[i] = v[i]->y;
     }
-    inside &= !crossing_near;
-    if (all_out != 0) return;
-    if (!crossing_near && rules_.front_faces_only) {
-      const glm::dvec3 a(clip[0].x, clip[0].y, clip[0].w), b(clip[1].x, clip[1].y, clip[1].w),
-          c(clip[2].x, clip[2].y, clip[2].w);
-      if (!(glm::dot(a, glm::cross(b, c)) > 0.0)) return;
+    if (double area = 0.0; rules_.front_faces_only) {
+      for (int i = 0; i < vertices; ++i)
+        area += s[i].x * s[(i + 1) % vertices].y - s[(i + 1) % vertices].x * s[i].y;
+      if (area > 0.0) raster_snapped(s, X, Y, vertices, count);  // rule 2: front faces only
+      return;
     }
+    raster_polygon(s, vertices, count);
+    return;
   }
   glm::dvec4 poly[kMax], next[kMax];
   int n = vertices;
-  std::copy(clip, clip + n, poly);
-  for (int p = 0; p < kPlanes && !inside; ++p) {
+  for (int i = 0; i < n; ++i) poly[i] = v[i]->clip;
+  for (int p = 0; p < kPlanes; ++p) {
     double d[kMax];
-    bool any_out = false, all_out = true;
+    bool any_out = false, none_in = true;
     for (int i = 0; i < n; ++i) {
       d[i] = distance(poly[i], p);
       any_out |= d[i] < 0.0;
-      all_out &= d[i] < 0.0;
+      none_in &= d[i] < 0.0;
     }
-    if (all_out) return;
+    if (none_in) return;
     if (!any_out) continue;
     int m = 0;
     for (int i = 0; i < n; ++i) {
@@ -380,15 +460,7 @@ void OcclusionBuffer::raster_clipped(const glm::dvec4* clip, int vertices, std::
     n = m;
     std::copy(next, next + n, poly);
   }
-  // Project: texel coordinates and the depth key (window depth, negated with reversed-Z).
-  glm::dvec3 s[kMax];
-  for (int i = 0; i < n; ++i) {
-    const glm::dvec4& c = poly[i];
-    const double ndc_z = c.z / c.w;
-    const double depth = clip_.depth == DepthRange::zero_to_one ? ndc_z : ndc_z * 0.5 + 0.5;
-    s[i] = {(c.x / c.w * 0.5 + 0.5) * double(width_), (c.y / c.w * 0.5 + 0.5) * double(height_),
-            clip_.reversed_z ? -depth : depth};
-  }
+  for (int i = 0; i < n; ++i) s[i] = project(poly[i]);
   raster_polygon(s, n, count);
 }
 
@@ -407,11 +479,18 @@ void OcclusionBuffer::raster_polygon(const glm::dvec3* in, int n, std::uint32_t&
   }
   // Rule 3: vertices snapped to 1/256 texel, edge functions exact in int64.
   std::int64_t X[kMax], Y[kMax];
-  std::int64_t snapped_area = 0;
   for (int k = 0; k < n; ++k) {
     X[k] = snap(v[k].x);
     Y[k] = snap(v[k].y);
   }
+  raster_snapped(v, X, Y, n, count);
+}
+
+// A front-facing convex polygon, counter-clockwise, its corners snapped to X, Y.
+void OcclusionBuffer::raster_snapped(const glm::dvec3* v, const std::int64_t* X, const std::int64_t* Y, int n,
+                                     std::uint32_t& count) {
+  constexpr int kMax = 9;
+  std::int64_t snapped_area = 0;
   for (int k = 0; k < n; ++k) snapped_area += X[k] * Y[(k + 1) % n] - X[(k + 1) % n] * Y[k];
   if (snapped_area <= 0) return;  // degenerate once snapped
   const std::int64_t min_x = *std::min_element(X, X + n), max_x = *std::max_element(X, X + n);
