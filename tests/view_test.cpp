@@ -236,3 +236,17 @@ TEST(Subpixel, OnlyASingleSampledViewSkipsAnything) {
   EXPECT_FALSE(holds_no_sample(flat_box(-8.9f, -7.1f, -8.9f, -7.1f), view));
   EXPECT_FALSE(holds_no_sample(Aabb{}, ten_by_ten()));  // empty
 }
+
+// The test reads the view's eye_projection, made by make_view; a View put
+// together by hand (all zero there) skips nothing rather than guessing.
+TEST(Subpixel, TheProjectionIsMakeViewsAndAHandMadeViewSkipsNothing) {
+  const View view = ten_by_ten();
+  EXPECT_EQ(view.eye_projection, eye_relative_projection(view));
+  const View from_matrices = make_view(view.view, view.proj, 10, 10);
+  EXPECT_EQ(from_matrices.eye_projection, eye_relative_projection(from_matrices));
+  const Aabb between = flat_box(-8.9f, -7.1f, -8.9f, -7.1f);
+  EXPECT_TRUE(holds_no_sample(between, from_matrices));
+  View by_hand = view;
+  by_hand.eye_projection = glm::dmat4(0.0);
+  EXPECT_FALSE(holds_no_sample(between, by_hand));
+}

@@ -12,7 +12,8 @@ namespace occull {
 
 /// One camera's view for one frame. Build it with make_view() (from an
 /// engine's matrices, or from a pose and a lens) so the derived members
-/// (eye, view_proj, frustum, near, far, near_radius) agree with the others.
+/// (eye, view_proj, frustum, near, far, near_radius, eye_projection) agree
+/// with the others.
 struct View {
   glm::vec3 eye{0.0f};       ///< camera position, world space (the view matrix's origin)
   glm::mat4 view{1.0f};      ///< world to eye space
@@ -41,6 +42,9 @@ struct View {
   /// box that holds no pixel centre (holds_no_sample): drawn, it would make
   /// no fragment.
   int samples = 1;
+  /// eye_relative_projection(*this), kept so that per-box tests
+  /// (holds_no_sample) need not multiply it again: derived by make_view.
+  glm::dmat4 eye_projection{0.0};
 };
 
 /// The projection times the view's rotation, in double: what positions

@@ -188,12 +188,14 @@ OccluderMesh make_occluder_mesh(std::span<const glm::vec3> positions, std::span<
     out.inradius.push_back(p.radius);
     out.bounds.push_back(p.bounds);
   }
-  std::vector<std::uint32_t> used(out.corners);
-  std::erase(used, OccluderMesh::no_corner);
-  const std::size_t corners = used.size();
-  std::sort(used.begin(), used.end());
-  used.erase(std::unique(used.begin(), used.end()), used.end());
-  out.shared_corners = corners >= 2 * used.size() && !used.empty();
+  std::vector<bool> used(positions.size(), false);
+  std::size_t corners = 0, vertices = 0;
+  for (const std::uint32_t c : out.corners) {
+    if (c == OccluderMesh::no_corner) continue;
+    ++corners;
+    if (!used[c]) used[c] = true, ++vertices;
+  }
+  out.shared_corners = vertices > 0 && corners >= 2 * vertices;
   return out;
 }
 

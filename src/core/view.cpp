@@ -46,7 +46,7 @@ bool holds_no_sample(const Aabb& box, const View& view, const SubpixelRules& rul
     hi += grow;
   }
   // Rule 3: eye-relative, in double.
-  const glm::dmat4 m = eye_relative_projection(view);
+  const glm::dmat4& m = view.eye_projection;  // all zero in a View not made by make_view: every box kept (w = 0)
   const glm::dvec3 eye(view.eye);
   const double near_depth = double(view.clip.near_depth());
   double min_x = std::numeric_limits<double>::infinity(), max_x = -min_x, min_y = min_x, max_y = -min_x;
@@ -134,6 +134,7 @@ View make_view(const glm::mat4& view, const glm::mat4& proj, int width, int heig
   v.clip = clip;
   v.eye = glm::vec3(glm::inverse(view)[3]);
   v.frustum = Frustum::from_view_projection(v.view_proj, clip);
+  v.eye_projection = eye_relative_projection(v);
   v.width = width;
   v.height = height;
   v.orthographic = orthographic;
