@@ -61,7 +61,13 @@ TEST(ConservativeCullers, MissNothingOnCityPaths) {
 // moving every 64 m of the walks (objects re-placed, the hierarchy refitted
 // and the cullers' state kept across each move).
 TEST(ConservativeCullers, MissNothingOnTheCityFarFromTheOrigin) {
+#ifdef OCCULL_TEST_SANITIZED
+  // Under the sanitizers (looking for memory errors, 3 minutes for all three
+  // offsets) the one that moves the origin grid; the plain build walks all.
+  for (const double offset : {-1e6}) {
+#else
   for (const double offset : {1e4, 1e6, -1e6}) {
+#endif
     Session session("city:blocks=4,traffic=40,offset=" + std::to_string(offset), small_target());
     if (offset < 0) session.set_origin_grid(64.0);
     EXPECT_GT(glm::length(session.origin()), 0.5 * std::abs(offset));
