@@ -8,8 +8,10 @@
 #include <glm/gtc/matrix_transform.hpp>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
+#include <random>
 
 using namespace occull;
 
@@ -249,4 +251,50 @@ TEST(Subpixel, TheProjectionIsMakeViewsAndAHandMadeViewSkipsNothing) {
   View by_hand = view;
   by_hand.eye_projection = glm::dmat4(0.0);
   EXPECT_FALSE(holds_no_sample(between, by_hand));
+}
+
+// holds_no_sample projects two corners, then the rest, and sums matrix
+// columns instead of multiplying each corner: it must decide as projecting
+// all 8 corners one by one does (the rules' definition, written out here).
+namespace {
+bool corner_by_corner(const Aabb& box, const View& view) {
+  glm::dvec3 lo(box.min), hi(box.max);
+  double magnitude = 0.0;
+  for (int a = 0; a < 3; ++a) magnitude = std::max({magnitude, std::abs(lo[a]), std::abs(hi[a])});
+  lo -= magnitude / 1048576.0;
+  hi += magnitude / 1048576.0;
+  double x0 = 1e300, x1 = -1e300, y0 = 1e300, y1 = -1e300;
+  for (int k = 0; k < 8; ++k) {
+    const glm::dvec3 p((k & 1) ? hi.x : lo.x, (k & 2) ? hi.y : lo.y, (k & 4) ? hi.z : lo.z);
+    const glm::dvec4 c = view.eye_projection * glm::dvec4(p - glm::dvec3(view.eye), 1.0);
+    if (c.w <= 0.0 || c.z <= double(view.clip.near_depth()) * c.w) return false;
+    const double x = (c.x / c.w * 0.5 + 0.5) * view.width, y = (c.y / c.w * 0.5 + 0.5) * view.height;
+    x0 = std::min(x0, x), x1 = std::max(x1, x), y0 = std::min(y0, y), y1 = std::max(y1, y);
+  }
+  const auto centre_in = [](double from, double to, int size) {
+    for (int i = 0; i < size; ++i)
+      if (from - 1.0 / 64.0 <= i + 0.5 && i + 0.5 <= to + 1.0 / 64.0) return true;
+    return false;
+  };
+  return !centre_in(x0, x1, view.width) || !centre_in(y0, y1, view.height);
+}
+}  // namespace
+
+TEST(Subpixel, AgreesWithProjectingEveryCornerOnRandomBoxes) {
+  const View view = make_view({glm::vec3(3.0f, 2.0f, 1.0f), 0.4f, -0.2f}, {70.0f, 0.5f, 500.0f}, 64, 36);
+  std::mt19937 random(46);
+  const auto uniform = [&](float a, float b) { return std::uniform_real_distribution<float>(a, b)(random); };
+  int culled = 0, kept = 0;
+  for (int i = 0; i < 20000; ++i) {
+    // Around the eye, most of them in front, from far away to through the near plane.
+    const glm::vec3 at = view.eye + glm::vec3(uniform(-20, 20), uniform(-12, 12), uniform(-40, 1));
+    const glm::vec3 size(uniform(0.0f, 0.4f), uniform(0.0f, 0.4f), uniform(0.0f, 0.4f));
+    const Aabb box{at, at + size};
+    const bool expected = corner_by_corner(box, view);
+    ASSERT_EQ(holds_no_sample(box, view), expected) << "box " << i;
+    (expected ? culled : kept) += 1;
+  }
+  // Both answers are common: the comparison says something.
+  EXPECT_GT(culled, 2000);
+  EXPECT_GT(kept, 2000);
 }

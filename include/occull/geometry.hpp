@@ -80,6 +80,9 @@ struct Aabb {
 
 /// Euclidean distance from point `p` to the box (0 when p is inside).
 [[nodiscard]] float distance(const glm::vec3& p, const Aabb& b) noexcept;
+/// The square of distance(p, b), without the square root: orders boxes by
+/// distance the same way (front-to-back traversals), in scene units squared.
+[[nodiscard]] float distance_squared(const glm::vec3& p, const Aabb& b) noexcept;
 
 /// Plane n·x + d = 0 with unit normal n; the positive half-space is "inside".
 struct Plane {

@@ -23,7 +23,7 @@ struct FrameStats {
   double pyramid_ms = 0.0;      ///< GPU time building depth pyramids (device culling: hiz)
   double device_cull_ms = 0.0;  ///< GPU time of device culling's test-and-write-commands dispatches
   double raster_ms = 0.0;  ///< CPU time rasterizing occluders into the occlusion buffer (soc; part of cpu_ms)
-  double test_ms = 0.0;    ///< CPU time testing boxes against the occlusion buffer (soc; part of cpu_ms)
+  double test_ms = 0.0;    ///< CPU time testing boxes against the occlusion buffer, estimated from one test in 8 (soc; part of cpu_ms)
 
   // What the operating system did during the frame (whole process, driver
   // threads included): page faults are allocator churn, not algorithm cost.

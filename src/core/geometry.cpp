@@ -31,10 +31,12 @@ Aabb transform_box(const Aabb& b, const glm::mat4& m) noexcept {
   return out;
 }
 
-float distance(const glm::vec3& p, const Aabb& b) noexcept {
-  const glm::vec3 q = glm::clamp(p, b.min, b.max);
-  return glm::length(p - q);
+float distance_squared(const glm::vec3& p, const Aabb& b) noexcept {
+  const glm::vec3 q = p - glm::clamp(p, b.min, b.max);
+  return glm::dot(q, q);
 }
+
+float distance(const glm::vec3& p, const Aabb& b) noexcept { return std::sqrt(distance_squared(p, b)); }
 
 Plane Plane::from_coefficients(const glm::vec4& abcd) noexcept {
   const glm::vec3 n(abcd);

@@ -41,28 +41,37 @@ bool holds_no_sample(const Aabb& box, const View& view, const SubpixelRules& rul
   if (rules.grow_for_rounding) {  // rule 2
     double magnitude = 0.0;
     for (int a = 0; a < 3; ++a) magnitude = std::max({magnitude, std::abs(lo[a]), std::abs(hi[a])});
-    const double grow = std::ldexp(magnitude, -20);
+    const double grow = magnitude * 0x1p-20;
     lo -= grow;
     hi += grow;
   }
-  // Rule 3: eye-relative, in double.
+  // Rule 3: eye-relative, in double. The corners' clip coordinates by
+  // linearity: the low corner's, plus one column of the matrix per axis
+  // scaled by the box's size (a few units in the last place of a double
+  // from multiplying each corner, far inside the 1/64 pixel margin).
   const glm::dmat4& m = view.eye_projection;  // all zero in a View not made by make_view: every box kept (w = 0)
-  const glm::dvec3 eye(view.eye);
+  const glm::dvec4 low = m * glm::dvec4(lo - glm::dvec3(view.eye), 1.0);
+  const glm::dvec3 size = hi - lo;
+  const glm::dvec4 along[3] = {m[0] * size.x, m[1] * size.y, m[2] * size.z};
   const double near_depth = double(view.clip.near_depth());
+  const double half_w = 0.5 * double(view.width), half_h = 0.5 * double(view.height);
   double min_x = std::numeric_limits<double>::infinity(), max_x = -min_x, min_y = min_x, max_y = -min_x;
-  for (int k = 0; k < 8; ++k) {
-    const glm::dvec3 p((k & 1) ? hi.x : lo.x, (k & 2) ? hi.y : lo.y, (k & 4) ? hi.z : lo.z);
-    const glm::dvec4 c = m * glm::dvec4(p - eye, 1.0);
+  // Adds corner k's pixel position to the rectangle; false when rule 4 keeps the box.
+  const auto add_corner = [&](int k) {
+    glm::dvec4 c = low;
+    if (k & 1) c += along[0];
+    if (k & 2) c += along[1];
+    if (k & 4) c += along[2];
     // Rule 4: every corner beyond the near plane.
     const bool beyond_near = view.clip.reversed_z ? c.z < c.w : c.z > near_depth * c.w;
     if (!(c.w > 0.0) || !beyond_near) return false;
-    const double x = (c.x / c.w * 0.5 + 0.5) * double(view.width), y = (c.y / c.w * 0.5 + 0.5) * double(view.height);
+    const double inv_w = 1.0 / c.w;
+    const double x = (c.x * inv_w + 1.0) * half_w, y = (c.y * inv_w + 1.0) * half_h;
     min_x = std::min(min_x, x), max_x = std::max(max_x, x);
     min_y = std::min(min_y, y), max_y = std::max(max_y, y);
-  }
+    return true;
+  };
   const double margin = rules.snapping_margin ? 1.0 / 64.0 : 0.0;
-  min_x -= margin, max_x += margin, min_y -= margin, max_y += margin;
-  if (!rules.pixel_centres) return max_x - min_x < 1.0 && max_y - min_y < 1.0;  // broken: a size threshold
   // Centres lie at k + 0.5, k in [0, size): the rectangle holds one on an
   // axis when the lowest centre at or past its start is at or before its end
   // (rule 5). Both axes must hold one.
@@ -70,7 +79,19 @@ bool holds_no_sample(const Aabb& box, const View& view, const SubpixelRules& rul
     const double first = std::max(0.0, std::ceil(from - 0.5));
     return first <= std::min(double(size - 1), std::floor(to - 0.5));
   };
-  return !holds_centre(min_x, max_x, view.width) || !holds_centre(min_y, max_y, view.height);
+  const auto holds_sample = [&] {
+    return holds_centre(min_x - margin, max_x + margin, view.width) &&
+           holds_centre(min_y - margin, max_y + margin, view.height);
+  };
+  // Two opposite corners first: when their rectangle already holds a
+  // centre, the other six only grow it (or keep the box by rule 4): kept.
+  if (!add_corner(0) || !add_corner(7)) return false;
+  if (rules.pixel_centres && holds_sample()) return false;
+  for (int k = 1; k < 7; ++k)
+    if (!add_corner(k)) return false;
+  if (!rules.pixel_centres)  // broken: a size threshold
+    return max_x - min_x + 2.0 * margin < 1.0 && max_y - min_y + 2.0 * margin < 1.0;
+  return !holds_sample();
 }
 
 View make_view(const glm::mat4& view, const glm::mat4& proj, int width, int height, const ClipSpace& clip) {

@@ -34,6 +34,15 @@ void Occluders::rasterize_if_occluder(OcclusionBuffer& buffer, ObjectId id, cons
   if (o.occluder == OccluderClass::sometimes) sometimes_left_ -= o.triangles;
 }
 
+bool test_box(OcclusionBuffer& buffer, const Aabb& box, const glm::mat4& view_proj, BufferCounters& counters) {
+  if (counters.boxes_tested++ % kTestsPerTimedTest != 0) return buffer.occluded(box, view_proj);
+  const auto start = std::chrono::steady_clock::now();
+  const bool out = buffer.occluded(box, view_proj);
+  counters.test_ms += double(kTestsPerTimedTest) *
+                      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  return out;
+}
+
 const OccluderMesh& Occluders::occluder_of(MeshId mesh) {
   if (meshes_.size() <= mesh) meshes_.resize(std::size_t(mesh) + 1);
   if (!meshes_[mesh]) {

@@ -23,14 +23,11 @@
 #include "occluders.hpp"
 #include "occull/occlusion_buffer.hpp"
 
-#include <chrono>
 #include <cmath>
 #include <optional>
 
 namespace occull::detail {
 namespace {
-
-using Clock = std::chrono::steady_clock;
 
 class SocCuller final : public Culler {
  public:
@@ -56,7 +53,7 @@ class SocCuller final : public Culler {
       const NodeId n = open.pop();
       ++result.nodes_visited;
       if (bvh.node(n).object_count == 0 || frustum_.outside(bvh, n)) continue;
-      if (n != Bvh::root() && hidden(buffer, bvh.node(n).bounds, view, counters)) continue;
+      if (n != Bvh::root() && test_box(buffer, bvh.node(n).bounds, view.view_proj, counters)) continue;
       if (!bvh.is_leaf(n)) {
         open.push(bvh, Bvh::left(n), view.eye);
         open.push(bvh, bvh.right(n), view.eye);
@@ -67,7 +64,7 @@ class SocCuller final : public Culler {
       // A leaf of one object: its box is the node's, tested above (the root aside).
       const bool tested = leaf_.size() == 1 && bvh.node(n).object_count == 1 && n != Bvh::root();
       for (ObjectId id : leaf_) {
-        if (!tested && hidden(buffer, index_.scene.object(id).bounds, view, counters)) continue;
+        if (!tested && test_box(buffer, index_.scene.object(id).bounds, view.view_proj, counters)) continue;
         queue_.push_back(id);
         occluders_.rasterize_if_occluder(buffer, id, view, counters);
       }
@@ -84,14 +81,6 @@ class SocCuller final : public Culler {
     const SimdPath simd = config_.simd ? SimdPath::best : SimdPath::scalar;
     if (!buffer_ || buffer_->width() != w || buffer_->height() != h) buffer_.emplace(w, h, simd);
     return *buffer_;
-  }
-
-  static bool hidden(OcclusionBuffer& buffer, const Aabb& box, const View& view, BufferCounters& counters) {
-    const auto start = Clock::now();
-    const bool out = buffer.occluded(box, view.view_proj);
-    counters.test_ms += std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-    ++counters.boxes_tested;
-    return out;
   }
 
   SceneIndex index_;

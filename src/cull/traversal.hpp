@@ -48,7 +48,7 @@ void pull_up_visibility(std::vector<Node>& state, const Bvh& bvh, NodeId n) {
 inline std::array<NodeId, 2> children_front_to_back(const Bvh& bvh, NodeId n, const glm::vec3& eye) {
   const NodeId l = Bvh::left(n);
   const NodeId r = bvh.right(n);
-  if (distance(eye, bvh.node(r).bounds) < distance(eye, bvh.node(l).bounds)) return {r, l};
+  if (distance_squared(eye, bvh.node(r).bounds) < distance_squared(eye, bvh.node(l).bounds)) return {r, l};
   return {l, r};
 }
 
@@ -149,7 +149,7 @@ void carry_over(std::vector<Node>& state, const Bvh& bvh, const ObjectVisibility
 class DistanceQueue {
  public:
   void push(const Bvh& bvh, NodeId n, const glm::vec3& eye) {
-    heap_.push({distance(eye, bvh.node(n).bounds), n});
+    heap_.push({distance_squared(eye, bvh.node(n).bounds), n});
   }
   NodeId pop() {
     const NodeId n = heap_.top().node;
@@ -160,10 +160,10 @@ class DistanceQueue {
 
  private:
   struct Entry {
-    float distance;
+    float distance_squared;
     NodeId node;
     bool operator>(const Entry& o) const {
-      return distance > o.distance || (distance == o.distance && node > o.node);
+      return distance_squared > o.distance_squared || (distance_squared == o.distance_squared && node > o.node);
     }
   };
   std::priority_queue<Entry, std::vector<Entry>, std::greater<>> heap_;

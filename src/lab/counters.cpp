@@ -35,7 +35,7 @@ constexpr std::array kCounters = std::to_array<Counter>({
     {"raster_ms", &F::raster_ms, none, C::sum, C::mean, C::median, "raster_ms_per_frame", &S::raster_ms_per_frame, 4,
      false, "ms", "CPU time rasterizing occluders into the occlusion buffer (soc; part of cpu_ms)"},
     {"test_ms", &F::test_ms, none, C::sum, C::mean, C::median, "test_ms_per_frame", &S::test_ms_per_frame, 4, false,
-     "ms", "CPU time testing boxes against the occlusion buffer (soc; part of cpu_ms)"},
+     "ms", "CPU time testing boxes against the occlusion buffer, estimated from one test in 8 (soc; part of cpu_ms)"},
     {"occluder_triangles", &F::occluder_triangles, none, C::sum, C::mean, C::median, "occluder_triangles_per_frame",
      &S::occluder_triangles_per_frame, -1, false, "count",
      "triangles rasterized into the occlusion buffer (soc; clipped, front faces)"},
