@@ -1,3 +1,4 @@
+#include "cull/traversal.hpp"
 #include "occull/cost_model.hpp"
 #include "occull/culler.hpp"
 #include "occull/error.hpp"
@@ -8,6 +9,7 @@
 
 #include <algorithm>
 #include <random>
+#include <set>
 
 using namespace occull;
 
@@ -246,4 +248,42 @@ TEST(Culler, HizOverABackendWithoutDeviceCullingIsTheCallersMistake) {
   } catch (const UsageError& e) {
     EXPECT_NE(std::string(e.what()).find("no device culling"), std::string::npos) << e.what();
   }
+}
+
+// The front-to-back queue holds its last push outside the heap: over a
+// whole descent (and pushes in any order) it pops exactly what an ordered
+// set of (squared distance, node id) does.
+TEST(DistanceQueue, PopsNearestFirstWithLowerIdsOnTies) {
+  const Scene scene = scattered(300, 7);
+  const Bvh bvh = Bvh::build(scene);
+  const glm::vec3 eye(3.0f, 1.0f, -2.0f);
+  detail::DistanceQueue queue;
+  std::set<std::pair<float, NodeId>> reference;
+  const auto push = [&](NodeId n) {
+    queue.push(bvh, n, eye);
+    reference.insert({distance_squared(eye, bvh.node(n).bounds), n});
+  };
+  push(Bvh::root());
+  std::size_t popped = 0;
+  while (!queue.empty()) {
+    ASSERT_FALSE(reference.empty());
+    const NodeId n = queue.pop();
+    ASSERT_EQ(n, reference.begin()->second) << "pop " << popped;
+    reference.erase(reference.begin());
+    ++popped;
+    if (!bvh.is_leaf(n)) {
+      // Children in both orders, so that the held entry is both kept and displaced.
+      if (n % 2 == 0) push(Bvh::left(n)), push(bvh.right(n));
+      else push(bvh.right(n)), push(Bvh::left(n));
+    }
+  }
+  EXPECT_TRUE(reference.empty());
+  EXPECT_EQ(popped, bvh.size());
+  // Pushes with no descent between them: far first, then nearer ones.
+  for (NodeId n = NodeId(bvh.size()); n-- > 0;) push(n);
+  for (std::size_t i = 0; i < bvh.size(); ++i) {
+    ASSERT_EQ(queue.pop(), reference.begin()->second) << "pop " << i;
+    reference.erase(reference.begin());
+  }
+  EXPECT_TRUE(queue.empty());
 }

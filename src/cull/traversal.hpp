@@ -13,6 +13,7 @@
 #include <array>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <queue>
 #include <vector>
 
@@ -146,17 +147,34 @@ void carry_over(std::vector<Node>& state, const Bvh& bvh, const ObjectVisibility
 
 /// Traversal queue ordered by distance from the eye to the node's box,
 /// nearest first (ties: lower node id first, so traversal is deterministic).
+/// The entry pushed last is held outside the heap while it is the nearest:
+/// a walk that pushes a node's two children and pops the nearer one at once
+/// (most of a front-to-back descent) pays one heap push instead of two
+/// pushes and a pop. The order is the heap's exactly.
 class DistanceQueue {
  public:
   void push(const Bvh& bvh, NodeId n, const glm::vec3& eye) {
-    heap_.push({distance_squared(eye, bvh.node(n).bounds), n});
+    const Entry e{distance_squared(eye, bvh.node(n).bounds), n};
+    if (!held_) {
+      held_ = e;
+    } else if (*held_ > e) {
+      heap_.push(*held_);
+      held_ = e;
+    } else {
+      heap_.push(e);
+    }
   }
   NodeId pop() {
+    if (held_ && (heap_.empty() || heap_.top() > *held_)) {
+      const NodeId n = held_->node;
+      held_.reset();
+      return n;
+    }
     const NodeId n = heap_.top().node;
     heap_.pop();
     return n;
   }
-  [[nodiscard]] bool empty() const { return heap_.empty(); }
+  [[nodiscard]] bool empty() const { return !held_ && heap_.empty(); }
 
  private:
   struct Entry {
@@ -166,6 +184,7 @@ class DistanceQueue {
       return distance_squared > o.distance_squared || (distance_squared == o.distance_squared && node > o.node);
     }
   };
+  std::optional<Entry> held_;  // the last push, while no later push was nearer; pop() takes the nearer of it and the top
   std::priority_queue<Entry, std::vector<Entry>, std::greater<>> heap_;
 };
 
