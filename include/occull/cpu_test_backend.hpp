@@ -47,7 +47,8 @@ class CpuTestBackend final : public Backend {
   /// Ends the frame: forgets the view; the frame's counters stay readable.
   void end_frame();
   /// The buffer's counters of the current (or last) frame: "raster_ms",
-  /// "test_ms" (CPU time rasterizing occluders and testing boxes, ms),
+  /// "test_ms" (CPU time rasterizing occluders and testing boxes, ms; the
+  /// tests' time estimated from one test in 8),
   /// "occluder_triangles", "boxes_tested", "buffer_texels".
   void visit_counters(const CounterVisitor& visit) const;
   /// The buffer of the current (or last) frame; null before the first.

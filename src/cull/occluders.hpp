@@ -33,8 +33,8 @@ struct BufferCounters {
 /// Tests `box` against `buffer` (OcclusionBuffer::occluded) and counts it in
 /// counters.boxes_tested. Only one test in kTestsPerTimedTest is timed, and its
 /// time times kTestsPerTimedTest added to counters.test_ms: reading the clock
-/// twice costs about as much as a quick box test (9 % of soc's CPU on field
-/// when every test was timed), so test_ms is a sampled estimate.
+/// twice costs about as much as a quick box test (docs/performance.md, "The
+/// walk's cost per box"), so test_ms is a sampled estimate.
 bool test_box(OcclusionBuffer& buffer, const Aabb& box, const glm::mat4& view_proj, BufferCounters& counters);
 inline constexpr std::uint64_t kTestsPerTimedTest = 8;
 

@@ -147,10 +147,11 @@ void carry_over(std::vector<Node>& state, const Bvh& bvh, const ObjectVisibility
 
 /// Traversal queue ordered by distance from the eye to the node's box,
 /// nearest first (ties: lower node id first, so traversal is deterministic).
-/// The entry pushed last is held outside the heap while it is the nearest:
-/// a walk that pushes a node's two children and pops the nearer one at once
-/// (most of a front-to-back descent) pays one heap push instead of two
-/// pushes and a pop. The order is the heap's exactly.
+/// The entry pushed last is held outside the heap until a nearer push
+/// displaces it, and pop() takes the nearer of it and the heap's top: a walk
+/// that pushes a node's two children and pops the nearer one at once (most
+/// of a front-to-back descent) pays one heap push instead of two pushes and
+/// a pop. The order is the heap's exactly.
 class DistanceQueue {
  public:
   void push(const Bvh& bvh, NodeId n, const glm::vec3& eye) {
@@ -184,7 +185,7 @@ class DistanceQueue {
       return distance_squared > o.distance_squared || (distance_squared == o.distance_squared && node > o.node);
     }
   };
-  std::optional<Entry> held_;  // the last push, while no later push was nearer; pop() takes the nearer of it and the top
+  std::optional<Entry> held_;  // the last push, unless a nearer one displaced it into heap_
   std::priority_queue<Entry, std::vector<Entry>, std::greater<>> heap_;
 };
 
