@@ -287,3 +287,37 @@ TEST(DistanceQueue, PopsNearestFirstWithLowerIdsOnTies) {
   }
   EXPECT_TRUE(queue.empty());
 }
+
+// A leaf's objects through the frustum cache: a one-object leaf the cache
+// passed is appended untested, and every leaf yields exactly what testing
+// its objects does — with one object a leaf and with several, for leaves
+// inside, outside and across the frustum, some holding no pixel centre.
+TEST(FrustumCache, AppendsALeafsObjectsAsTestingThemDoes) {
+  const Scene scene = scattered(2000, 5);
+  for (const int per_leaf : {1, 4}) {
+    const Bvh bvh = Bvh::build(scene, BvhOptions{.max_leaf_objects = per_leaf});
+    const SceneIndex index{scene, bvh};
+    detail::FrustumCache cache;
+    std::size_t appended = 0, outside = 0, in_leaves = 0;  // objects
+    for (const float yaw : {0.0f, 1.0f, 2.5f, 4.0f}) {
+      const View view = make_view({{3, 1, -4}, yaw, 0.1f}, {60.0f, 0.1f, 80.0f}, 160, 90);
+      cache.begin(bvh, view);
+      for (NodeId n = 0; n < bvh.size(); ++n) {
+        if (!bvh.is_leaf(n) || bvh.node(n).object_count == 0) continue;
+        in_leaves += bvh.node(n).object_count;
+        if (cache.outside(bvh, n)) outside += bvh.node(n).object_count;
+        std::vector<ObjectId> got, expected;
+        cache.append_objects(index, n, got);
+        detail::append_objects_in_frustum(index, n, view, expected, cache.planes(n));
+        ASSERT_EQ(got, expected) << "leaf " << n << ", " << per_leaf << " a leaf, yaw " << yaw;
+        appended += got.size();
+      }
+    }
+    EXPECT_GT(appended, 100u) << per_leaf;
+    EXPECT_GT(outside, 100u) << per_leaf;
+    // One object a leaf: the leaf's test is its object's. Several: some
+    // objects of a leaf that passed fail their own test.
+    if (per_leaf == 1) EXPECT_EQ(appended + outside, in_leaves);
+    else EXPECT_LT(appended + outside, in_leaves);
+  }
+}

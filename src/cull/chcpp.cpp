@@ -263,7 +263,7 @@ class ChcppCuller final : public CpuTestedCuller {
 
   void traverse(NodeId n) {
     if (is_leaf(n)) {
-      append_objects_in_frustum(index_, n, *f_.view, render_queue_, frustum_.planes(n));
+      frustum_.append_objects(index_, n, render_queue_);
       render_queue_triangles_ += index_.bvh.node(n).triangles;
       if (config_.render_batch_triangles > 0 && render_queue_triangles_ >= config_.render_batch_triangles) {
         flush_render_queue();

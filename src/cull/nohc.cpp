@@ -288,7 +288,7 @@ class NohcCuller final : public CpuTestedCuller {
   void process(NodeId n) {
     if (is_leaf(n)) {
       const std::size_t before = render_queue_.size();
-      append_objects_in_frustum(index_, n, *f_.view, render_queue_, frustum_.planes(n));
+      frustum_.append_objects(index_, n, render_queue_);
       if (render_queue_.size() > before) {
         NodeCost cost;
         cost.c_bb = c_bb(n);

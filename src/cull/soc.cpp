@@ -60,7 +60,7 @@ class SocCuller final : public Culler {
         continue;
       }
       leaf_.clear();
-      append_objects_in_frustum(index_, n, view, leaf_, frustum_.planes(n));
+      frustum_.append_objects(index_, n, leaf_);
       // A leaf of one object: its box is the node's, tested above (the root aside).
       const bool tested = leaf_.size() == 1 && bvh.node(n).object_count == 1 && n != Bvh::root();
       for (ObjectId id : leaf_) {

@@ -189,6 +189,14 @@ class DistanceQueue {
   std::priority_queue<Entry, std::vector<Entry>, std::greater<>> heap_;
 };
 
+/// Appends the objects of node `n` whose boxes are not outside the frustum
+/// and hold a sample (occull/view.hpp holds_no_sample: exact sub-pixel
+/// culling; every culler but vfc skips such objects).
+/// `planes`: the frustum planes `n` is not known to lie fully inside (a
+/// Frustum plane mask); objects are tested against those only.
+void append_objects_in_frustum(const SceneIndex& index, NodeId n, const View& view,
+                               std::vector<ObjectId>& out, std::uint32_t planes = Frustum::all_planes);
+
 /// Per-node frustum tests of one view, made once per frame: a node's test
 /// skips the planes its parent lies fully inside (front-to-back traversals
 /// classify a parent before its children; any order stays correct).
@@ -217,6 +225,22 @@ class FrustumCache {
   }
   /// The planes node `n` is not fully inside. Precondition: outside(n) was asked this frame.
   [[nodiscard]] std::uint32_t planes(NodeId n) const { return nodes_[n].planes; }
+
+  /// Appends the objects of leaf `n` in the frustum that hold a sample, as
+  /// append_objects_in_frustum(index, n, view, out, planes(n)) does. A real
+  /// leaf of one object that outside(n) passed this frame is appended with
+  /// no test of its own: its box is its object's (Bvh: a node's box is the
+  /// union of its objects'), the box outside(n) tested. Any other node is
+  /// tested object by object.
+  void append_objects(const SceneIndex& index, NodeId n, std::vector<ObjectId>& out) const {
+    const BvhNode& node = index.bvh.node(n);
+    const Entry& e = nodes_[n];
+    if (node.is_leaf() && node.object_count == 1 && e.frame == frame_ && !e.outside) {
+      out.push_back(index.bvh.objects(n).front());
+      return;
+    }
+    append_objects_in_frustum(index, n, *view_, out, e.frame == frame_ ? e.planes : Frustum::all_planes);
+  }
 
  private:
   struct Entry {
@@ -276,14 +300,6 @@ inline bool near_eye(const Aabb& box, const View& view, float radius) {
 void collect_in_frustum_front_to_back(const SceneIndex& index, const View& view,
                                       std::vector<ObjectId>& out, std::uint64_t& nodes_visited,
                                       bool subpixel = true);
-
-/// Appends the objects of node `n` whose boxes are not outside the frustum
-/// and hold a sample (occull/view.hpp holds_no_sample: exact sub-pixel
-/// culling; every culler but vfc skips such objects).
-/// `planes`: the frustum planes `n` is not known to lie fully inside (a
-/// Frustum plane mask); objects are tested against those only.
-void append_objects_in_frustum(const SceneIndex& index, NodeId n, const View& view,
-                               std::vector<ObjectId>& out, std::uint32_t planes = Frustum::all_planes);
 
 /// Appends the boxes of node `n`'s query.
 inline void append_query_boxes(const SceneIndex& index, NodeId n, const QueryShape& shape,
