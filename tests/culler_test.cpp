@@ -291,32 +291,38 @@ TEST(DistanceQueue, PopsNearestFirstWithLowerIdsOnTies) {
 // A leaf's objects through the frustum cache: a one-object leaf the cache
 // passed is appended untested, and every leaf yields exactly what testing
 // its objects does — with one object a leaf and with several, for leaves
-// inside, outside and across the frustum, some holding no pixel centre.
+// inside, outside and across the frustum, and for removed objects (empty
+// boxes in leaves the frustum's planes need not test: never appended).
 TEST(FrustumCache, AppendsALeafsObjectsAsTestingThemDoes) {
-  const Scene scene = scattered(2000, 5);
   for (const int per_leaf : {1, 4}) {
-    const Bvh bvh = Bvh::build(scene, BvhOptions{.max_leaf_objects = per_leaf});
+    Scene scene = scattered(2000, 5);
+    Bvh bvh = Bvh::build(scene, BvhOptions{.max_leaf_objects = per_leaf});
+    // Removed objects: their leaves keep them, with an empty box, until a rebuild.
+    for (ObjectId id = 0; id < scene.objects().size(); id += 7) scene.remove_object(id);
+    bvh.refit(scene);
     const SceneIndex index{scene, bvh};
     detail::FrustumCache cache;
     std::size_t appended = 0, outside = 0, in_leaves = 0;  // objects
     for (const float yaw : {0.0f, 1.0f, 2.5f, 4.0f}) {
       const View view = make_view({{3, 1, -4}, yaw, 0.1f}, {60.0f, 0.1f, 80.0f}, 160, 90);
       cache.begin(bvh, view);
-      for (NodeId n = 0; n < bvh.size(); ++n) {
+      for (NodeId n = 0; n < bvh.size(); ++n) {  // parents first: a child tests the planes its parent straddles
+        const bool out = cache.outside(bvh, n);
         if (!bvh.is_leaf(n) || bvh.node(n).object_count == 0) continue;
-        in_leaves += bvh.node(n).object_count;
-        if (cache.outside(bvh, n)) outside += bvh.node(n).object_count;
         std::vector<ObjectId> got, expected;
         cache.append_objects(index, n, got);
         detail::append_objects_in_frustum(index, n, view, expected, cache.planes(n));
         ASSERT_EQ(got, expected) << "leaf " << n << ", " << per_leaf << " a leaf, yaw " << yaw;
         appended += got.size();
+        if (bvh.node(n).bounds.empty()) continue;  // removed objects only
+        in_leaves += bvh.node(n).object_count;
+        if (out) outside += bvh.node(n).object_count;
       }
     }
     EXPECT_GT(appended, 100u) << per_leaf;
     EXPECT_GT(outside, 100u) << per_leaf;
     // One object a leaf: the leaf's test is its object's. Several: some
-    // objects of a leaf that passed fail their own test.
+    // objects of a leaf that passed fail their own test (removed ones too).
     if (per_leaf == 1) EXPECT_EQ(appended + outside, in_leaves);
     else EXPECT_LT(appended + outside, in_leaves);
   }

@@ -230,12 +230,13 @@ class FrustumCache {
   /// append_objects_in_frustum(index, n, view, out, planes(n)) does. A real
   /// leaf of one object that outside(n) passed this frame is appended with
   /// no test of its own: its box is its object's (Bvh: a node's box is the
-  /// union of its objects'), the box outside(n) tested. Any other node is
-  /// tested object by object.
+  /// union of its objects'), the box outside(n) tested, unless that box is
+  /// empty (a removed object's: outside(n) passes an empty box whose parent
+  /// lies inside the frustum). Any other node is tested object by object.
   void append_objects(const SceneIndex& index, NodeId n, std::vector<ObjectId>& out) const {
     const BvhNode& node = index.bvh.node(n);
     const Entry& e = nodes_[n];
-    if (node.is_leaf() && node.object_count == 1 && e.frame == frame_ && !e.outside) {
+    if (node.is_leaf() && node.object_count == 1 && !node.bounds.empty() && e.frame == frame_ && !e.outside) {
       out.push_back(index.bvh.objects(n).front());
       return;
     }
