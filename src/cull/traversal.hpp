@@ -155,7 +155,12 @@ void carry_over(std::vector<Node>& state, const Bvh& bvh, const ObjectVisibility
 class DistanceQueue {
  public:
   void push(const Bvh& bvh, NodeId n, const glm::vec3& eye) {
-    const Entry e{distance_squared(eye, bvh.node(n).bounds), n};
+    const BvhNode& node = bvh.node(n);
+    // When n is popped its children are pushed: the left one follows n in
+    // the array, the right one lies far away (a cache miss in soc's
+    // front-to-back walk, which leaves the array's order). Fetch it now.
+    if (!node.is_leaf()) __builtin_prefetch(&bvh.node(node.right));
+    const Entry e{distance_squared(eye, node.bounds), n};
     if (!held_) {
       held_ = e;
     } else if (*held_ > e) {
