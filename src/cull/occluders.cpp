@@ -16,17 +16,18 @@ void Occluders::begin_frame(const View& view, const OcclusionBuffer& buffer) {
   sometimes_left_ = std::uint64_t(choice_.budget);
 }
 
-void Occluders::rasterize_if_occluder(OcclusionBuffer& buffer, ObjectId id, const View& view, BufferCounters& counters) {
+void Occluders::rasterize_if_occluder(OcclusionBuffer& buffer, ObjectId id, const Aabb& bounds, const View& view,
+                                      BufferCounters& counters) {
+  // How many texels across the box's bounding sphere spans: a smaller
+  // occluder covers next to no texel whole (rule 3), and costs its polygons.
+  const double radius = 0.5 * double(glm::length(bounds.extent()));
+  const double distance = view.orthographic ? 1.0 : std::max(double(glm::length(bounds.center() - view.eye)), 1e-6);
+  if (2.0 * radius * texel_scale_ / distance < choice_.min_texels) return;
   const Object& o = scene_.object(id);
   if (o.removed || o.occluder == OccluderClass::never || scene_.material(o.material).translucent) return;
   const Mesh& mesh = scene_.mesh(o.mesh);
   if (mesh.positions.empty()) return;  // the engine keeps its vertices: nothing to rasterize
   if (o.occluder == OccluderClass::sometimes && o.triangles > sometimes_left_) return;
-  // How many texels across the box's bounding sphere spans: a smaller
-  // occluder covers next to no texel whole (rule 3), and costs its polygons.
-  const double radius = 0.5 * double(glm::length(o.bounds.extent()));
-  const double distance = view.orthographic ? 1.0 : std::max(double(glm::length(o.bounds.center() - view.eye)), 1e-6);
-  if (2.0 * radius * texel_scale_ / distance < choice_.min_texels) return;
   const auto start = std::chrono::steady_clock::now();
   const std::uint32_t drawn = buffer.rasterize(mesh.positions, occluder_of(o.mesh), view, o.transform, o.bounds);
   counters.raster_ms += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();

@@ -51,7 +51,16 @@ class Occluders {
   /// Rasterizes object `id` if it is an occluder; adds the time and
   /// polygons to counters.raster_ms and counters.occluder_triangles. The
   /// caller guarantees the object is drawn in this frame.
-  void rasterize_if_occluder(OcclusionBuffer& buffer, ObjectId id, const View& view, BufferCounters& counters);
+  void rasterize_if_occluder(OcclusionBuffer& buffer, ObjectId id, const View& view, BufferCounters& counters) {
+    rasterize_if_occluder(buffer, id, scene_.object(id).bounds, view, counters);
+  }
+  /// The same, given the object's world box `bounds` (a one-object leaf's
+  /// box, in cache where the object is not): the size test goes first and
+  /// reads nothing else, so an object too small to occlude is passed over
+  /// without reading it (a cache miss per object on the field: 14 % of
+  /// soc's CPU there). Precondition: `bounds` is the object's box.
+  void rasterize_if_occluder(OcclusionBuffer& buffer, ObjectId id, const Aabb& bounds, const View& view,
+                             BufferCounters& counters);
 
  private:
   const OccluderMesh& occluder_of(MeshId mesh);

@@ -64,9 +64,10 @@ class SocCuller final : public Culler {
       // A leaf of one object: its box is the node's, tested above (the root aside).
       const bool tested = leaf_.size() == 1 && bvh.node(n).object_count == 1 && n != Bvh::root();
       for (ObjectId id : leaf_) {
-        if (!tested && test_box(buffer, index_.scene.object(id).bounds, view.view_proj, counters)) continue;
+        const Aabb& box = tested ? bvh.node(n).bounds : index_.scene.object(id).bounds;
+        if (!tested && test_box(buffer, box, view.view_proj, counters)) continue;
         queue_.push_back(id);
-        occluders_.rasterize_if_occluder(buffer, id, view, counters);
+        occluders_.rasterize_if_occluder(buffer, id, box, view, counters);
       }
     }
     if (!queue_.empty()) backend.render(queue_);
