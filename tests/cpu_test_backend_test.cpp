@@ -5,8 +5,10 @@
 #include "occull/culler.hpp"
 #include "test_util.hpp"
 
+#include <glm/gtc/matrix_transform.hpp>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <map>
 #include <string_view>
 
@@ -149,6 +151,44 @@ TEST(Soc, DrawsTheWallAndWhatIsInFrontOfItButNotWhatIsBehind) {
   EXPECT_TRUE(device.queried.empty());
   EXPECT_GT(test::counter(*soc, "occluder_triangles"), 0.0);
   EXPECT_GT(test::counter(*soc, "boxes_tested"), 0.0);
+}
+
+// soc leaves untested an interior node that held a drawn object in the last
+// frame: the next frame of the same view tests fewer boxes and draws the
+// same; when the wall then moves in front of what was shown, the objects'
+// own tests hide them, as a fresh soc does.
+TEST(Soc, AnInteriorNodeShownLastFrameIsNotTestedAgainButItsObjectsAre) {
+  std::vector<Aabb> boxes = {{{-40, -40, -11}, {40, 40, -10}}};  // 0: the wall
+  for (int i = 0; i < 16; ++i) {
+    const float x = -8.0f + float(i);
+    boxes.push_back({{x, -0.4f, -6.0f}, {x + 0.8f, 0.4f, -5.0f}});    // in front of it
+    boxes.push_back({{x, -0.4f, -30.0f}, {x + 0.8f, 0.4f, -29.0f}});  // behind it
+  }
+  Scene scene = test::box_scene(boxes);
+  Bvh bvh = Bvh::build(scene);
+  ScriptedBackend device;
+  auto soc = make_culler("soc", {scene, bvh});
+  const auto frame = [&](Culler& culler) {
+    device.rendered.clear();
+    (void)culler.render_frame(camera(), device);
+    std::sort(device.rendered.begin(), device.rendered.end());
+    return std::pair{device.rendered, test::counter(culler, "boxes_tested")};
+  };
+  const auto [first, first_tests] = frame(*soc);
+  ASSERT_GT(first.size(), 8u);  // the wall and the row in front of it (odd ids), in the frustum
+  for (ObjectId id : first) EXPECT_TRUE(id == 0 || id % 2 == 1) << id;
+  const auto [second, second_tests] = frame(*soc);
+  EXPECT_EQ(second, first);
+  EXPECT_LT(second_tests, first_tests);
+  // The wall moves in front of the row: every node over the row was shown.
+  scene.set_transform(0, glm::translate(glm::mat4(1.0f), glm::vec3(0.0f, 0.0f, 6.5f)));
+  bvh.refit(scene);
+  scene.clear_moved();
+  const auto [third, third_tests] = frame(*soc);
+  auto fresh = make_culler("soc", {scene, bvh});
+  const auto [expected, fresh_tests] = frame(*fresh);
+  EXPECT_EQ(expected, std::vector<ObjectId>{0});
+  EXPECT_EQ(third, expected);
 }
 
 TEST(Soc, AnOccluderWithoutVerticesOnTheCpuHidesNothing) {

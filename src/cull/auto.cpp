@@ -34,7 +34,8 @@
 //     45 ms, its own cost 30, hiz 41: auto kept hiz). After vfc (it drew
 //     the whole frustum) there is nothing to hand over, and the candidate
 //     resumes from its own state.
-//   - soc and vfc keep no state across frames: nothing to keep warm.
+//   - soc and vfc keep no visibility across frames: nothing to keep warm
+//     (soc's nodes shown last frame only spare it tests).
 //   - What a switch still costs is priced in: every frame a candidate runs
 //     is measured, the first one of a try included.
 //

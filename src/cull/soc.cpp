@@ -16,6 +16,12 @@
 // anything. Everything rasterized is drawn in the same frame (it passed its
 // own test first), so a box the buffer hides is hidden on screen: the
 // culler is conservative exactly when the buffer is.
+// An interior node that held a drawn object in the last frame is not
+// tested: it is most likely visible again, and its children are tested. A
+// box inside a hidden box is hidden by the same test (its rectangle is
+// inside the other's, its nearest depth no nearer), so skipping the test
+// changes what the walk costs, not what it draws. Its first frame, with no
+// last frame, tests every node.
 // The queue is drawn in one render-queue flush at the end.
 #include "cullers.hpp"
 #include "traversal.hpp"
@@ -46,6 +52,14 @@ class SocCuller final : public Culler {
     queue_.clear();
     frustum_.begin(index_.bvh, view);
     const Bvh& bvh = index_.bvh;
+    if (shown_.size() != bvh.size() || generation_ != bvh.generation()) {
+      shown_.assign(bvh.size(), 0);
+      generation_ = bvh.generation();
+    }
+    if (++frame_ == 0) {  // wrapped: no node may look shown last frame
+      std::fill(shown_.begin(), shown_.end(), 0u);
+      frame_ = 2;
+    }
 
     DistanceQueue open;
     open.push(bvh, Bvh::root(), view.eye);
@@ -53,7 +67,9 @@ class SocCuller final : public Culler {
       const NodeId n = open.pop();
       ++result.nodes_visited;
       if (bvh.node(n).object_count == 0 || frustum_.outside(bvh, n)) continue;
-      if (n != Bvh::root() && test_box(buffer, bvh.node(n).bounds, view.view_proj, counters)) continue;
+      const bool shown_last_frame = !bvh.is_leaf(n) && shown_[n] + 1 == frame_;
+      if (n != Bvh::root() && !shown_last_frame && test_box(buffer, bvh.node(n).bounds, view.view_proj, counters))
+        continue;
       if (!bvh.is_leaf(n)) {
         open.push(bvh, Bvh::left(n), view.eye);
         open.push(bvh, bvh.right(n), view.eye);
@@ -68,6 +84,7 @@ class SocCuller final : public Culler {
         if (!tested && test_box(buffer, box, view.view_proj, counters)) continue;
         queue_.push_back(id);
         occluders_.rasterize_if_occluder(buffer, id, box, view, counters);
+        for (NodeId m = n; m != kNoNode && shown_[m] != frame_; m = bvh.node(m).parent) shown_[m] = frame_;
       }
     }
     if (!queue_.empty()) backend.render(queue_);
@@ -91,6 +108,9 @@ class SocCuller final : public Culler {
   std::optional<OcclusionBuffer> buffer_;
   FrustumCache frustum_;
   std::vector<ObjectId> queue_, leaf_;
+  std::vector<std::uint32_t> shown_;  // per node: the last frame_ it held a drawn object (0: none)
+  std::uint32_t frame_ = 1;
+  std::uint64_t generation_ = 0;      // of the hierarchy shown_ follows
 };
 
 }  // namespace
