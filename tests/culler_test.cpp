@@ -288,6 +288,26 @@ TEST(DistanceQueue, PopsNearestFirstWithLowerIdsOnTies) {
   EXPECT_TRUE(queue.empty());
 }
 
+// The frustum cache's sub-pixel test left out on request: for an interior
+// node only (it then culls less); a leaf is always tested in full.
+TEST(FrustumCache, LeavesOutTheSubpixelTestForInteriorNodesOnly) {
+  // Two specks far down the view: each, and their parent, hold no pixel centre.
+  const Scene scene = test::box_scene({{{0.0f, 0.0f, -50.0f}, {0.001f, 0.001f, -49.999f}},
+                                       {{0.003f, 0.0f, -50.0f}, {0.004f, 0.001f, -49.999f}}});
+  const Bvh bvh = Bvh::build(scene);
+  ASSERT_FALSE(bvh.is_leaf(Bvh::root()));
+  const View view = make_view(CameraPose{}, Lens{60.0f, 0.1f, 100.0f}, 64, 64);
+  ASSERT_TRUE(holds_no_sample(bvh.node(Bvh::root()).bounds, view));
+  detail::FrustumCache cache;
+  cache.begin(bvh, view);
+  EXPECT_TRUE(cache.outside(bvh, Bvh::root()));
+  cache.begin(bvh, view);
+  EXPECT_FALSE(cache.outside(bvh, Bvh::root(), false));
+  const NodeId leaf = Bvh::left(Bvh::root());
+  ASSERT_TRUE(bvh.is_leaf(leaf));
+  EXPECT_TRUE(cache.outside(bvh, leaf, false));
+}
+
 // A leaf's objects through the frustum cache: a one-object leaf the cache
 // passed is appended untested, and every leaf yields exactly what testing
 // its objects does — with one object a leaf and with several, for leaves

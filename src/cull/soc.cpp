@@ -17,7 +17,8 @@
 // own test first), so a box the buffer hides is hidden on screen: the
 // culler is conservative exactly when the buffer is.
 // An interior node that held a drawn object in the last frame is not
-// tested: it is most likely visible again, and its children are tested. A
+// tested, against the buffer nor for holding a pixel centre: it is most
+// likely visible again, and its children are tested. A
 // box inside a hidden box is hidden by the same test (its rectangle is
 // inside the other's, its nearest depth no nearer), so skipping the test
 // changes what the walk costs, not what it draws. Its first frame, with no
@@ -66,8 +67,8 @@ class SocCuller final : public Culler {
     while (!open.empty()) {
       const NodeId n = open.pop();
       ++result.nodes_visited;
-      if (bvh.node(n).object_count == 0 || frustum_.outside(bvh, n)) continue;
       const bool shown_last_frame = !bvh.is_leaf(n) && shown_[n] + 1 == frame_;
+      if (bvh.node(n).object_count == 0 || frustum_.outside(bvh, n, !shown_last_frame)) continue;
       if (n != Bvh::root() && !shown_last_frame && test_box(buffer, bvh.node(n).bounds, view.view_proj, counters))
         continue;
       if (!bvh.is_leaf(n)) {

@@ -214,15 +214,17 @@ class FrustumCache {
     view_ = &view;
   }
   /// Whether node `n`'s box lies outside the frustum or holds no sample
-  /// (holds_no_sample: exact sub-pixel culling).
-  bool outside(const Bvh& bvh, NodeId n) {
+  /// (holds_no_sample: exact sub-pixel culling; `subpixel` false leaves
+  /// that test out for an interior node a caller expects to hold one,
+  /// which culls less, never more: its leaves are tested in full).
+  bool outside(const Bvh& bvh, NodeId n, bool subpixel = true) {
     Entry& e = nodes_[n];
     if (e.frame != frame_) {
       const NodeId parent = bvh.node(n).parent;
       std::uint32_t mask =
           parent != kNoNode && nodes_[parent].frame == frame_ ? nodes_[parent].planes : Frustum::all_planes;
       e.outside = (mask != 0 && view_->frustum.classify(bvh.node(n).bounds, mask) == Containment::outside) ||
-                  holds_no_sample(bvh.node(n).bounds, *view_);
+                  ((subpixel || bvh.node(n).is_leaf()) && holds_no_sample(bvh.node(n).bounds, *view_));
       e.planes = std::uint8_t(mask);
       e.frame = frame_;
     }
