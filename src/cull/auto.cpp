@@ -514,9 +514,12 @@ class AutoCuller final : public Culler {
   // The frame's cost reaches the schedule; with the owner's measure (frame
   // time, and its parts), vfc's cost is estimated too: it would draw the
   // frustum at the cost per unit drawn of this frame (the frame's time less
-  // the culler's CPU and query waits, over what it drew). The estimate errs
-  // high: fixed costs of the frame count as drawing, and so do the objects
-  // the culler hid, which would fail the depth test. It spares a try where
+  // the culler's CPU, over what it drew). The estimate errs high: fixed
+  // costs of the frame count as drawing, and so do the objects the culler
+  // hid, which would fail the depth test, and the culler's query waits (the
+  // device drawing what it was given, which vfc's frame pays too, and any
+  // stall: taken out, they left llvmpipe's drawing at 1280x720 unpriced and
+  // vfc took over at a tenth of its cost: VfcsEstimatePricesQueryWaitsAsDrawing). It spares a try where
   // vfc would lose by far (a dense city), and switches to vfc where even so
   // it is cheaper than the current by the margin (open ground, where the
   // culler hides little and its own CPU is what it adds).
@@ -526,7 +529,7 @@ class AutoCuller final : public Culler {
     // (Not from hiz's frames: what the device drew is read back after the frame, if at all.)
     if (measured.frame_ms > 0.0 && drawn > 0.0 && !candidates_[last_].frustum && !candidates_[last_].device) {
       // The median of the last kPriceFrames frames' price: one frame's spike does not skip vfc's try.
-      prices_[priced_++ % kPriceFrames] = std::max(0.0, measured.frame_ms - measured.cpu_ms - measured.wait_ms) / drawn;
+      prices_[priced_++ % kPriceFrames] = std::max(0.0, measured.frame_ms - measured.cpu_ms) / drawn;
       std::array<double, kPriceFrames> sorted = prices_;
       const std::size_t n = std::min<std::size_t>(priced_, kPriceFrames);
       std::nth_element(sorted.begin(), sorted.begin() + n / 2, sorted.begin() + n);
