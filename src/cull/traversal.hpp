@@ -223,7 +223,9 @@ class FrustumCache {
       const NodeId parent = bvh.node(n).parent;
       std::uint32_t mask =
           parent != kNoNode && nodes_[parent].frame == frame_ ? nodes_[parent].planes : Frustum::all_planes;
-      e.outside = (mask != 0 && view_->frustum.classify(bvh.node(n).bounds, mask) == Containment::outside) ||
+      // An empty box (removed objects only) is outside whatever the planes, as in in_frustum().
+      e.outside = (mask != 0 ? view_->frustum.classify(bvh.node(n).bounds, mask) == Containment::outside
+                             : bvh.node(n).bounds.empty()) ||
                   ((subpixel || bvh.node(n).is_leaf()) && holds_no_sample(bvh.node(n).bounds, *view_));
       e.planes = std::uint8_t(mask);
       e.frame = frame_;
@@ -237,13 +239,12 @@ class FrustumCache {
   /// append_objects_in_frustum(index, n, view, out, planes(n)) does. A real
   /// leaf of one object that outside(n) passed this frame is appended with
   /// no test of its own: its box is its object's (Bvh: a node's box is the
-  /// union of its objects'), the box outside(n) tested, unless that box is
-  /// empty (a removed object's: outside(n) passes an empty box whose parent
-  /// lies inside the frustum). Any other node is tested object by object.
+  /// union of its objects'), the box outside(n) tested. Any other node is
+  /// tested object by object.
   void append_objects(const SceneIndex& index, NodeId n, std::vector<ObjectId>& out) const {
     const BvhNode& node = index.bvh.node(n);
     const Entry& e = nodes_[n];
-    if (node.is_leaf() && node.object_count == 1 && !node.bounds.empty() && e.frame == frame_ && !e.outside) {
+    if (node.is_leaf() && node.object_count == 1 && e.frame == frame_ && !e.outside) {
       out.push_back(index.bvh.objects(n).front());
       return;
     }
