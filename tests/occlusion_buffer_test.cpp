@@ -3,6 +3,8 @@
 // rule switched off (OcclusionRules) hiding it — a test that cannot fail
 // proves nothing.
 #include "occull/occlusion_buffer.hpp"
+
+#include "core/fixed_point.hpp"
 #include "occull/depth_pyramid.hpp"
 #include "occull/view.hpp"
 
@@ -495,5 +497,53 @@ TEST(OcclusionBuffer, SharedVerticesRasterizeAsSeparateTriangles) {
     for (std::size_t i = 0; i < shared.keys().size(); ++i)
       ASSERT_EQ(std::bit_cast<std::uint32_t>(shared.keys()[i]), std::bit_cast<std::uint32_t>(one_by_one.keys()[i]))
           << "buffer " << shared.width() << "x" << shared.height() << " texel " << i;
+  }
+}
+
+// The rasterizer's integer bounds divide without a 64-bit division where the
+// operands fit a double: the same floor as the plain division, for every
+// sign, at exact multiples, one step off them, and around 2^52 where it
+// hands over to the division.
+TEST(FixedPoint, FloorDivWithoutIntegerDivisionEqualsFloorDiv) {
+  std::mt19937_64 rng(11);
+  std::vector<std::pair<std::int64_t, std::int64_t>> cases;
+  const std::int64_t big = std::int64_t(1) << 52;
+  for (const std::int64_t b : {std::int64_t(1), std::int64_t(3), std::int64_t(256), std::int64_t(65536 * 3),
+                               big - 1, big, big + 1})
+    for (const std::int64_t q : {std::int64_t(0), std::int64_t(1), std::int64_t(7), std::int64_t(1) << 30})
+      for (const std::int64_t d : {-1, 0, 1})
+        for (const std::int64_t sign : {-1, 1})
+          if (q <= (std::int64_t(1) << 61) / b) cases.emplace_back(sign * (q * b + d), b);
+  for (const std::int64_t a : {big - 1, big, big + 1, -big + 1, -big, -big - 1}) cases.emplace_back(a, 3);
+  for (int i = 0; i < 200000; ++i) {
+    const int bits_a = int(rng() % 60), bits_b = int(rng() % 56);
+    const std::int64_t a = std::int64_t(rng() >> (64 - bits_a - 1)) * (rng() & 1 ? 1 : -1);
+    const std::int64_t b = std::max<std::int64_t>(1, std::int64_t(rng() >> (64 - bits_b - 1)));
+    cases.emplace_back(a, b);
+  }
+  int negative = 0;
+  for (const auto& [a, b] : cases) {
+    ASSERT_EQ(detail::floor_div_bounded(a, b), detail::floor_div(a, b)) << a << " / " << b;
+    negative += a < 0 && a % b != 0;
+  }
+  EXPECT_GT(negative, 1000);  // the floor and the truncation differ in these
+}
+
+// next_up is std::nextafter toward +infinity for every kind of float.
+TEST(FixedPoint, NextUpEqualsNextafter) {
+  constexpr float inf = std::numeric_limits<float>::infinity();
+  std::vector<float> values = {0.0f, -0.0f, 1.0f, -1.0f, inf, -inf, std::numeric_limits<float>::denorm_min(),
+                               -std::numeric_limits<float>::denorm_min(), std::numeric_limits<float>::max(),
+                               -std::numeric_limits<float>::max(), std::numeric_limits<float>::min(),
+                               -std::numeric_limits<float>::min()};
+  std::mt19937 rng(5);
+  for (int i = 0; i < 100000; ++i) values.push_back(std::bit_cast<float>(std::uint32_t(rng())));
+  for (const float x : values) {
+    if (std::isnan(x)) {
+      EXPECT_TRUE(std::isnan(detail::next_up(x)));
+      continue;
+    }
+    ASSERT_EQ(std::bit_cast<std::uint32_t>(detail::next_up(x)), std::bit_cast<std::uint32_t>(std::nextafter(x, inf)))
+        << x;
   }
 }

@@ -291,6 +291,7 @@ class OcclusionBuffer {
   std::vector<ClipVertex> vertices_;
   std::vector<std::uint32_t> vertex_stamp_;
   std::uint32_t stamp_ = 0;
+  std::vector<std::uint32_t> chosen_;  // a call's polygons to rasterize (scratch)
 };
 
 }  // namespace occull

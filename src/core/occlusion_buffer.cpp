@@ -6,6 +6,7 @@
 #include "occlusion_buffer_simd.hpp"
 #include "occull/error.hpp"
 #include "core/format.hpp"
+#include "core/fixed_point.hpp"
 
 #include <algorithm>
 #include <array>
@@ -42,10 +43,9 @@ constexpr double kGrowTexels = double(kGrow) / double(kSub);
   return best;
 }
 
-std::int64_t floor_div(std::int64_t a, std::int64_t b) {  // b > 0
-  const std::int64_t q = a / b;
-  return (a % b != 0 && a < 0) ? q - 1 : q;
-}
+using detail::floor_div;
+using detail::floor_div_bounded;
+using detail::next_up;
 
 // A texel coordinate to the nearest 1/256 texel (ties to even), for |v| <
 // 2^20: adding 1.5 * 2^52 leaves no fraction bits in the sum, and the
@@ -295,24 +295,35 @@ std::uint32_t OcclusionBuffer::rasterize(std::span<const glm::vec3> positions, c
   const double depth_stretch = glm::length(depth_axis);
   const double near = double(view.near);
   const double half_side = covered_half_side(), circle = 0.785 * 4.0 * half_side * half_side;  // pi/4 of the square
+  // The polygons chosen first, into a list with no branch a polygon (which
+  // side of the eye a terrain's polygon faces is a coin toss to the
+  // predictor), then rasterized in their order.
+  chosen_.resize(count);
+  std::size_t chosen = 0;
+  const bool any_side = !rules_.front_faces_only;
+  if (half_side <= 0.0) {  // rule 10, one pixel a texel: any polygon may hold a pixel centre
+    for (std::size_t p = 0; p < count; ++p) {
+      const OccluderMesh::Bounds& b = mesh.bounds[p];
+      const double side = flip * (glm::dot(glm::dvec3(b.normal), eye) - double(b.offset));
+      chosen_[chosen] = std::uint32_t(p);
+      chosen += std::size_t(any_side | (side > 0.0));
+    }
+  } else {
+    for (std::size_t p = 0; p < count; ++p) {
+      const OccluderMesh::Bounds& b = mesh.bounds[p];
+      const double side = flip * (glm::dot(glm::dvec3(b.normal), eye) - double(b.offset));
+      const glm::dvec3 centre(b.centre);
+      const double z = std::max(glm::dot(depth_axis, centre) + depth_offset - depth_stretch * double(b.radius), near);
+      const double texels = per_unit / z;  // per object unit, at most
+      const double cosine = std::min(1.0, std::abs(side) / std::max(glm::length(eye - centre), 1e-30));
+      chosen_[chosen] = std::uint32_t(p);
+      chosen += std::size_t((any_side | (side > 0.0)) & !(double(mesh.inradius[p]) * texels < half_side) &
+                            !(double(b.area) * cosine * texels * texels < circle));
+    }
+  }
   std::uint32_t drawn = 0;
   if (mesh.shared_corners) begin_vertices(positions.size());
-  for (std::size_t p = 0; p < count; ++p) {
-    const OccluderMesh::Bounds& b = mesh.bounds[p];
-    const double side = flip * (glm::dot(glm::dvec3(b.normal), eye) - double(b.offset));
-    if (rules_.front_faces_only && side <= 0.0) continue;
-    if (half_side <= 0.0) {  // rule 10, one pixel a texel: any polygon may hold a pixel centre
-      raster_mesh_polygon(positions, mesh, p, object_to_clip, drawn);
-      continue;
-    }
-    const glm::dvec3 centre(b.centre);
-    const double z = std::max(glm::dot(depth_axis, centre) + depth_offset - depth_stretch * double(b.radius), near);
-    const double texels = per_unit / z;  // per object unit, at most
-    if (double(mesh.inradius[p]) * texels < half_side) continue;
-    const double cosine = std::min(1.0, std::abs(side) / std::max(glm::length(eye - centre), 1e-30));
-    if (double(b.area) * cosine * texels * texels < circle) continue;
-    raster_mesh_polygon(positions, mesh, p, object_to_clip, drawn);
-  }
+  for (std::size_t i = 0; i < chosen; ++i) raster_mesh_polygon(positions, mesh, chosen_[i], object_to_clip, drawn);
   return drawn;
 }
 
@@ -566,9 +577,9 @@ void OcclusionBuffer::raster_snapped(const glm::dvec3* v, const std::int64_t* X,
     const double inset = double(inset_) / double(kSub);  // rule 10
     fx = gx > 0.0 ? 1.0 - inset + kGrowTexels : inset - kGrowTexels;
     fy = gy > 0.0 ? 1.0 - inset + kGrowTexels : inset - kGrowTexels;
-    bias = std::ldexp(std::max(std::abs(z_far), std::abs(z_near)) + (z_far - z_near), -20) + off_plane;
+    bias = (std::max(std::abs(z_far), std::abs(z_near)) + (z_far - z_near)) * 0x1p-20 + off_plane;  // exact, as ldexp
     cap = float(z_far);
-    if (double(cap) < z_far) cap = std::nextafter(cap, kInf);
+    if (double(cap) < z_far) cap = next_up(cap);
   }
   const float step = float(gx);
   const bool strict = rules_.inner_coverage;
@@ -595,9 +606,9 @@ void OcclusionBuffer::raster_snapped(const glm::dvec3* v, const std::int64_t* X,
     if (b.side == 0) continue;
     b.d = s > 0 ? s : -s;
     const std::int64_t n0 = s > 0 ? -b.r : b.r, dn = s > 0 ? -b.dr : b.dr;
-    b.q = floor_div(n0, b.d);
+    b.q = floor_div_bounded(n0, b.d);
     b.rem = n0 - b.q * b.d;
-    b.dq = floor_div(dn, b.d);
+    b.dq = floor_div_bounded(dn, b.d);
     b.drem = dn - b.dq * b.d;
   }
   for (int ty = y_lo; ty <= y_hi; ++ty) {
@@ -632,7 +643,7 @@ void OcclusionBuffer::raster_snapped(const glm::dvec3* v, const std::int64_t* X,
     if (lo > hi) continue;
     const double base_d = p0.z + gx * (double(lo) + fx - p0.x) + gy * (double(ty) + fy - p0.y) + bias;
     float base = float(base_d);
-    if (double(base) < base_d) base = std::nextafter(base, kInf);
+    if (double(base) < base_d) base = next_up(base);
     float* row = keys_.data() + std::size_t(ty) * std::size_t(width_) + std::size_t(lo);
     const int span = int(hi - lo + 1);
     if (simd_ == SimdPath::best)
