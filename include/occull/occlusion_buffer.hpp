@@ -155,6 +155,13 @@ struct OccluderMesh {
     float area;  ///< object units squared
   };
   std::vector<Bounds> bounds;
+  /// 4 per polygon: the polygon across its edge from corner k to corner k + 1
+  /// (mod its corners), the edge's ends matched by position, when the mesh
+  /// uses that edge once in each direction (a manifold edge between two
+  /// polygons wound alike); no_corner otherwise (an open border, a T-junction,
+  /// an edge of three polygons, a polygon left out by `detail`), and for a
+  /// triangle's fourth. Rule 11 fuses the pairs.
+  std::vector<std::uint32_t> neighbours;
   /// Whether its polygons share corners (at least 2 corners a vertex, as a
   /// terrain's or a smooth mesh's do, not a flat-shaded box's): then each
   /// vertex is transformed and projected once a call, not once a corner.
@@ -271,6 +278,12 @@ class OcclusionBuffer {
   void raster_clipped(ClipVertex* const* v, int n, std::uint32_t& count);
   void raster_polygon(const glm::dvec3* v, int n, std::uint32_t& count);
   void raster_snapped(const glm::dvec3* v, const std::int64_t* X, const std::int64_t* Y, int n, std::uint32_t& count);
+  struct Edge;
+  struct DepthPlane;
+  static constexpr int kMaxEdges = 9;  ///< edges of a region: a polygon clipped at 5 planes, or a fused pair (rule 11)
+  int polygon_edges(const std::int64_t* X, const std::int64_t* Y, int n, Edge* edges) const;
+  bool depth_plane(const glm::dvec3* v, int n, DepthPlane& out) const;
+  void fill_region(const Edge* edges, int edge_count, int x_lo, int x_hi, int y_lo, int y_hi, const DepthPlane& plane);
   float tile_farthest(int tx, int ty);
   /// Half the side of what a texel must have inside a polygon to be covered
   /// (the texel, or with rule 10 its pixel centres' square), in texels.

@@ -188,6 +188,28 @@ OccluderMesh make_occluder_mesh(std::span<const glm::vec3> positions, std::span<
     out.inradius.push_back(p.radius);
     out.bounds.push_back(p.bounds);
   }
+  // Rule 11's pairs: each directed edge's polygon, kept only when the mesh
+  // uses that edge once in that direction.
+  constexpr std::uint32_t kMany = OccluderMesh::no_corner;
+  std::unordered_map<Key, std::uint32_t, Hash> directed;
+  directed.reserve(out.corners.size());
+  const auto corner_count = [&](std::size_t p) { return out.corners[4 * p + 3] == OccluderMesh::no_corner ? 3 : 4; };
+  for (std::size_t p = 0; p < out.polygons(); ++p)
+    for (int k = 0, n = corner_count(p); k < n; ++k) {
+      const auto [it, added] = directed.emplace(key(out.corners[4 * p + std::size_t(k)],
+                                                    out.corners[4 * p + std::size_t((k + 1) % n)]),
+                                                std::uint32_t(p));
+      if (!added) it->second = kMany;
+    }
+  out.neighbours.assign(out.corners.size(), OccluderMesh::no_corner);
+  for (std::size_t p = 0; p < out.polygons(); ++p)
+    for (int k = 0, n = corner_count(p); k < n; ++k) {
+      const std::uint32_t a = out.corners[4 * p + std::size_t(k)], b = out.corners[4 * p + std::size_t((k + 1) % n)];
+      if (directed.at(key(a, b)) != std::uint32_t(p)) continue;  // this direction used twice
+      const auto across = directed.find(key(b, a));
+      if (across != directed.end() && across->second != kMany && across->second != std::uint32_t(p))
+        out.neighbours[4 * p + std::size_t(k)] = across->second;
+    }
   std::vector<bool> used(positions.size(), false);
   std::size_t corners = 0, vertices = 0;
   for (const std::uint32_t c : out.corners) {
@@ -499,10 +521,81 @@ void OcclusionBuffer::raster_polygon(const glm::dvec3* in, int n, std::uint32_t&
   raster_snapped(v, X, Y, n, count);
 }
 
+// An edge function of a region: a texel is inside when
+// a * (x + ox) + b * (y + oy) + c > 0 (x, y its lower left corner, fixed
+// point; ox, oy the corner of its square tested; >= 0 with rule 3 off).
+struct OcclusionBuffer::Edge {
+  std::int64_t a, b, c, ox, oy;
+};
+
+// A region's depth bound: the plane through p0 with slopes gx, gy (per
+// texel), taken at (fx, fy) in each texel, plus bias, no farther than cap.
+struct OcclusionBuffer::DepthPlane {
+  glm::dvec3 p0;
+  double gx, gy, fx, fy, bias, off_plane;
+  float cap;
+};
+
+// The edges of a counter-clockwise polygon snapped to X, Y (those between
+// corners snapped together left out), each tested at the corner of the grown
+// texel (rule 10: centres' square) farthest outside it. Returns how many.
+int OcclusionBuffer::polygon_edges(const std::int64_t* X, const std::int64_t* Y, int n, Edge* edges) const {
+  int edge_count = 0;
+  for (int i = 0; i < n; ++i) {
+    const int j = (i + 1) % n;
+    if (X[i] == X[j] && Y[i] == Y[j]) continue;  // snapped onto its neighbour
+    Edge& e = edges[edge_count++];
+    e.a = Y[i] - Y[j];
+    e.b = X[j] - X[i];
+    e.c = -(e.a * X[i] + e.b * Y[i]);
+    if (rules_.inner_coverage) {  // the grown texel's (rule 10: centres' square's) corner
+      e.ox = e.a > 0 ? inset_ - kGrow : kSub - inset_ + kGrow;
+      e.oy = e.b > 0 ? inset_ - kGrow : kSub - inset_ + kGrow;
+    } else {
+      e.ox = e.oy = kSub / 2;  // the texel's centre (rule 3 broken)
+    }
+  }
+  return edge_count;
+}
+
+// Rule 4: the depth plane through the three corners spanning the largest
+// triangle, at the grown texel's farthest corner; the bias covers float
+// evaluation and the other corners' distance off the plane. False for a
+// polygon with no area.
+bool OcclusionBuffer::depth_plane(const glm::dvec3* v, int n, DepthPlane& out) const {
+  int best = 1;
+  double best_area = 0.0;
+  for (int k = 1; k + 1 < n; ++k) {
+    const double a2 = (v[k].x - v[0].x) * (v[k + 1].y - v[0].y) - (v[k + 1].x - v[0].x) * (v[k].y - v[0].y);
+    if (a2 > best_area) best_area = a2, best = k;
+  }
+  const glm::dvec3 p0 = v[0], p1 = v[best], p2 = v[best + 1];
+  const double det = (p1.x - p0.x) * (p2.y - p0.y) - (p2.x - p0.x) * (p1.y - p0.y);
+  if (!(det > 0.0)) return false;
+  const double gx = ((p1.z - p0.z) * (p2.y - p0.y) - (p2.z - p0.z) * (p1.y - p0.y)) / det;
+  const double gy = ((p1.x - p0.x) * (p2.z - p0.z) - (p2.x - p0.x) * (p1.z - p0.z)) / det;
+  double z_far = -std::numeric_limits<double>::infinity(), z_near = std::numeric_limits<double>::infinity();
+  double off_plane = 0.0;
+  for (int k = 0; k < n; ++k) {
+    z_far = std::max(z_far, v[k].z);
+    z_near = std::min(z_near, v[k].z);
+    off_plane = std::max(off_plane, std::abs(v[k].z - (p0.z + gx * (v[k].x - p0.x) + gy * (v[k].y - p0.y))));
+  }
+  out = {p0, gx, gy, 0.5, 0.5, 0.0, off_plane, kInf};
+  if (rules_.farthest_depth) {
+    const double inset = double(inset_) / double(kSub);  // rule 10
+    out.fx = gx > 0.0 ? 1.0 - inset + kGrowTexels : inset - kGrowTexels;
+    out.fy = gy > 0.0 ? 1.0 - inset + kGrowTexels : inset - kGrowTexels;
+    out.bias = (std::max(std::abs(z_far), std::abs(z_near)) + (z_far - z_near)) * 0x1p-20 + off_plane;  // exact, as ldexp
+    out.cap = float(z_far);
+    if (double(out.cap) < z_far) out.cap = next_up(out.cap);
+  }
+  return true;
+}
+
 // A front-facing convex polygon, counter-clockwise, its corners snapped to X, Y.
 void OcclusionBuffer::raster_snapped(const glm::dvec3* v, const std::int64_t* X, const std::int64_t* Y, int n,
                                      std::uint32_t& count) {
-  constexpr int kMax = 9;
   std::int64_t snapped_area = 0;
   for (int k = 0; k < n; ++k) snapped_area += X[k] * Y[(k + 1) % n] - X[(k + 1) % n] * Y[k];
   if (snapped_area <= 0) return;  // degenerate once snapped
@@ -526,76 +619,33 @@ void OcclusionBuffer::raster_snapped(const glm::dvec3* v, const std::int64_t* X,
   const int y_lo = int(std::max<std::int64_t>(0, rules_.inner_coverage ? first(min_y) : floor_div(min_y, kSub)));
   const int y_hi = int(std::min<std::int64_t>(height_ - 1, last(max_y)));
   if (x_lo > x_hi || y_lo > y_hi) return;
+  // Edge i runs from vertex i to i+1. (A polygon that snapping left not
+  // quite convex is covered where it is inside every edge: a part of it.)
+  Edge edges[kMaxEdges];
+  const int edge_count = polygon_edges(X, Y, n, edges);
+  DepthPlane plane;
+  if (!depth_plane(v, n, plane)) return;
+  fill_region(edges, edge_count, x_lo, x_hi, y_lo, y_hi, plane);
+}
 
-  // Edge i runs from vertex i to i+1; inside is A*x + B*y + C > 0. The
-  // texel corner each edge is tested at: the one farthest outside it. (A
-  // polygon that snapping left not quite convex is covered where it is
-  // inside every edge: a part of it.)
-  struct Edge {
-    std::int64_t a, b, c, ox, oy;
-  } edges[kMax];
-  int edge_count = 0;
-  for (int i = 0; i < n; ++i) {
-    const int j = (i + 1) % n;
-    if (X[i] == X[j] && Y[i] == Y[j]) continue;  // snapped onto its neighbour
-    Edge& e = edges[edge_count++];
-    e.a = Y[i] - Y[j];
-    e.b = X[j] - X[i];
-    e.c = -(e.a * X[i] + e.b * Y[i]);
-    if (rules_.inner_coverage) {  // the grown texel's (rule 10: centres' square's) corner
-      e.ox = e.a > 0 ? inset_ - kGrow : kSub - inset_ + kGrow;
-      e.oy = e.b > 0 ? inset_ - kGrow : kSub - inset_ + kGrow;
-    } else {
-      e.ox = e.oy = kSub / 2;  // the texel's centre (rule 3 broken)
-    }
-  }
-
-  // Rule 4: the depth plane through the three corners spanning the largest
-  // triangle, at the grown texel's farthest corner; the bias covers float
-  // evaluation and the other corners' distance off the plane.
-  int best = 1;
-  double best_area = 0.0;
-  for (int k = 1; k + 1 < n; ++k) {
-    const double a2 = (v[k].x - v[0].x) * (v[k + 1].y - v[0].y) - (v[k + 1].x - v[0].x) * (v[k].y - v[0].y);
-    if (a2 > best_area) best_area = a2, best = k;
-  }
-  const glm::dvec3 p0 = v[0], p1 = v[best], p2 = v[best + 1];
-  const double det = (p1.x - p0.x) * (p2.y - p0.y) - (p2.x - p0.x) * (p1.y - p0.y);
-  if (!(det > 0.0)) return;
-  const double gx = ((p1.z - p0.z) * (p2.y - p0.y) - (p2.z - p0.z) * (p1.y - p0.y)) / det;
-  const double gy = ((p1.x - p0.x) * (p2.z - p0.z) - (p2.x - p0.x) * (p1.z - p0.z)) / det;
-  double z_far = -std::numeric_limits<double>::infinity(), z_near = std::numeric_limits<double>::infinity();
-  double off_plane = 0.0;
-  for (int k = 0; k < n; ++k) {
-    z_far = std::max(z_far, v[k].z);
-    z_near = std::min(z_near, v[k].z);
-    off_plane = std::max(off_plane, std::abs(v[k].z - (p0.z + gx * (v[k].x - p0.x) + gy * (v[k].y - p0.y))));
-  }
-  double fx = 0.5, fy = 0.5, bias = 0.0;
-  float cap = kInf;
-  if (rules_.farthest_depth) {
-    const double inset = double(inset_) / double(kSub);  // rule 10
-    fx = gx > 0.0 ? 1.0 - inset + kGrowTexels : inset - kGrowTexels;
-    fy = gy > 0.0 ? 1.0 - inset + kGrowTexels : inset - kGrowTexels;
-    bias = (std::max(std::abs(z_far), std::abs(z_near)) + (z_far - z_near)) * 0x1p-20 + off_plane;  // exact, as ldexp
-    cap = float(z_far);
-    if (double(cap) < z_far) cap = next_up(cap);
-  }
-  const float step = float(gx);
+// Writes the depth bound into every texel of [x_lo, x_hi] × [y_lo, y_hi]
+// inside every edge.
+void OcclusionBuffer::fill_region(const Edge* edges, int edge_count, int x_lo, int x_hi, int y_lo, int y_hi,
+                                  const DepthPlane& plane) {
   const bool strict = rules_.inner_coverage;
-
+  const float step = float(plane.gx);
   // Each edge bounds a row's covered texels on one side: e(tx) = s*tx + r(ty),
   // s = 256 a, r linear in ty. The bound floor(N/D) (N = -r, D = s when s > 0;
   // N = r, D = -s when s < 0) is stepped from row to row exactly, quotient
   // and remainder, with no division per row.
-  // A polygon over a few texels (most, at one pixel a texel) is cheaper
+  // A region over a few texels (most, at one pixel a texel) is cheaper
   // tested texel by texel: the same edge functions, no division.
   constexpr int kFewTexels = 16;
   const bool few = (x_hi - x_lo + 1) * (y_hi - y_lo + 1) <= kFewTexels;
   struct Bound {
     int side;  // +1: a lower bound (s > 0), -1: an upper bound (s < 0), 0: the edge is horizontal
     std::int64_t q, rem, dq, drem, d, r, dr;
-  } bounds[kMax];
+  } bounds[kMaxEdges];
   for (int k = 0; k < edge_count && !few; ++k) {
     const Edge& e = edges[k];
     Bound& b = bounds[k];
@@ -641,15 +691,16 @@ void OcclusionBuffer::raster_snapped(const glm::dvec3* v, const std::int64_t* X,
       if (b.rem >= b.d) b.rem -= b.d, ++b.q;
     }
     if (lo > hi) continue;
-    const double base_d = p0.z + gx * (double(lo) + fx - p0.x) + gy * (double(ty) + fy - p0.y) + bias;
+    const double base_d = plane.p0.z + plane.gx * (double(lo) + plane.fx - plane.p0.x) +
+                          plane.gy * (double(ty) + plane.fy - plane.p0.y) + plane.bias;
     float base = float(base_d);
     if (double(base) < base_d) base = next_up(base);
     float* row = keys_.data() + std::size_t(ty) * std::size_t(width_) + std::size_t(lo);
     const int span = int(hi - lo + 1);
     if (simd_ == SimdPath::best)
-      simd::fill_span(row, span, base, step, cap);
+      simd::fill_span(row, span, base, step, plane.cap);
     else
-      fill_span_scalar(row, span, base, step, cap);
+      fill_span_scalar(row, span, base, step, plane.cap);
     std::uint8_t* dirty = tile_dirty_.data() + std::size_t(ty / tile_size) * std::size_t(tiles_x_);
     for (int t = int(lo) / tile_size; t <= int(hi) / tile_size; ++t) dirty[t] = 1;
   }
