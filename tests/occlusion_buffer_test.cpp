@@ -384,6 +384,34 @@ TEST(OcclusionBuffer, OccluderMeshMergesCoplanarConvexPairsAndSortsLargestFirst)
   EXPECT_EQ(quads, 2);
 }
 
+// Rule 11's pairs: polygons across an edge used once in each direction (by
+// position: the two halves of the fold below share no vertex), and no
+// other: not an edge of three polygons, not two polygons wound against
+// each other, not an open border, not a quad's merged diagonal.
+TEST(OcclusionBuffer, OccluderMeshPairsPolygonsAcrossManifoldEdgesOnly) {
+  const auto pairs = [](const std::vector<glm::vec3>& positions, const std::vector<std::uint32_t>& indices) {
+    const OccluderMesh mesh = make_occluder_mesh(positions, indices);
+    std::vector<std::pair<std::uint32_t, std::uint32_t>> out;
+    for (std::size_t p = 0; p < mesh.polygons(); ++p)
+      for (int k = 0; k < 4; ++k)
+        if (const std::uint32_t q = mesh.neighbours[4 * p + std::size_t(k)]; q != OccluderMesh::no_corner)
+          out.emplace_back(std::uint32_t(p), q);
+    return out;
+  };
+  const glm::vec3 e0 = at(5, 0, 5), e1 = at(5, 8, 5), left = at(1, 4, 5), right = at(9, 4, 7), third = at(7, 2, 9);
+  // A fold: two triangles, each its own vertices, across e0-e1.
+  const auto fold = pairs({e0, e1, left, e1, e0, right}, {0, 1, 2, 3, 4, 5});
+  ASSERT_EQ(fold.size(), 2u);
+  EXPECT_EQ(fold[0].first, fold[1].second);
+  EXPECT_EQ(fold[0].second, fold[1].first);
+  EXPECT_TRUE(pairs({e0, e1, left, e1, e0, right, e1, e0, third}, {0, 1, 2, 3, 4, 5, 6, 7, 8}).empty())
+      << "three polygons on one edge";
+  EXPECT_TRUE(pairs({e0, e1, left, e0, e1, right}, {0, 1, 2, 3, 4, 5}).empty()) << "wound against each other";
+  Polys quad;  // coplanar halves: merged, their diagonal no edge
+  quad.rect(0.0f, 4.0f, 0.0f, 4.0f, 5.0f);
+  EXPECT_TRUE(pairs(quad.positions, quad.indices).empty());
+}
+
 // The tiles' farthest depths only shortcut the texels' answer.
 TEST(OcclusionBuffer, TilesAnswerAsTexelsDo) {
   std::mt19937 rng(11);
@@ -485,7 +513,9 @@ TEST(OcclusionBuffer, SharedVerticesRasterizeAsSeparateTriangles) {
                                                                              0.0f, 0.0f, 1.0f, 0.0f,  //
                                                                              3.0f, -1.5f, -4.0f, 1.0f});
   for (const int size : {1, 10}) {  // texels of 10 × 10 pixels, covered whole; one pixel each, at its centre
+    // Rule 11 off: the mesh's pairs fused would cover more than its triangles one by one.
     OcclusionBuffer shared(160 / size, 90 / size), one_by_one(160 / size, 90 / size);
+    shared.set_fused_pairs(false);
     for (OcclusionBuffer* b : {&shared, &one_by_one}) size == 1 ? b->clear(view) : b->clear(view.clip);
     std::uint32_t polygons = 0, triangles = 0;
     for (const glm::dmat4& m : {glm::dmat4(view.view_proj), moved}) {
@@ -546,4 +576,105 @@ TEST(FixedPoint, NextUpEqualsNextafter) {
     ASSERT_EQ(std::bit_cast<std::uint32_t>(detail::next_up(x)), std::bit_cast<std::uint32_t>(std::nextafter(x, inf)))
         << x;
   }
+}
+
+namespace {
+// Two triangles of one mesh, A on the left and B on the right, sharing the
+// vertical edge x = `edge` from texel row `from` to `to` (texel coordinates
+// of the buffer, one pixel a texel); A's third corner at `a`, B's at `b`,
+// each at its own distance. Not in one plane: OccluderMesh keeps them apart.
+struct Pair {
+  float edge, from, to;
+  glm::vec3 a, b;      // texel x, texel y, distance
+  float edge_distance = 5.0f;
+  Polys polys() const {
+    Polys p;
+    p.positions = {at(edge, from, edge_distance), at(edge, to, edge_distance), at(a.x, a.y, a.z), at(b.x, b.y, b.z)};
+    p.indices = {0, 1, 2, 1, 0, 3};  // A: up the edge, then left; B: down it, then right
+    return p;
+  }
+};
+}  // namespace
+
+// Rule 11: a pixel centre 0.005 texel from the edge two polygons share is
+// covered by neither alone (rule 3's growth, 1/64 texel), but the GPU draws
+// it with one of them: fused, the pair covers it.
+TEST(OcclusionBufferFusion, APixelCentreOnASharedEdgeIsCoveredByThePair) {
+  const Pair pair{5.505f, -2.0f, 11.0f, {-5.0f, 4.5f, 5.0f}, {20.0f, 4.5f, 6.0f}};
+  const OccluderMesh mesh = make_occluder_mesh(pair.polys().positions, pair.polys().indices);
+  ASSERT_EQ(mesh.polygons(), 2u);
+  ASSERT_NE(mesh.neighbours[0] + mesh.neighbours[1] + mesh.neighbours[2], 3 * OccluderMesh::no_corner);
+  const Aabb behind = box(5.45f, 5.55f, 3.3f, 3.7f, 10.0f);
+  Sampled fused(1);
+  fused.draw(pair.polys());
+  EXPECT_TRUE(fused.hidden(behind));
+  Sampled apart(1);
+  apart.buffer.set_fused_pairs(false);
+  apart.draw(pair.polys());
+  EXPECT_FALSE(apart.hidden(behind)) << "texel column 5 lies on the seam";
+  // The whole column (the edge runs from below the buffer to above it), and nothing else.
+  EXPECT_EQ(fused.buffer.covered_texels(), apart.buffer.covered_texels() + std::size_t(kH));
+}
+
+// Rule 11: the band is bounded by both polygons' other edges, grown. Here
+// B is a sliver narrowing to the edge's lower end (3.0): the centre (5.5,
+// 3.5) lies 0.01 texel right of the edge, within the band, but outside B
+// (and A): the GPU draws nothing there.
+TEST(OcclusionBufferFusion, TheBandEndsAtBothPolygonsOtherEdges) {
+  const Pair pair{5.49f, 3.0f, 11.0f, {-5.0f, 7.0f, 5.0f}, {5.59f, 11.0f, 6.0f}};
+  const Aabb behind = box(5.45f, 5.55f, 3.3f, 3.7f, 10.0f);
+  Sampled f(1);
+  f.draw(pair.polys());
+  EXPECT_FALSE(f.hidden(behind));
+  EXPECT_TRUE(f.hidden(box(4.45f, 4.55f, 5.3f, 5.7f, 10.0f)));  // A covers its own texels
+  Sampled broken(1, {.fusion_other_edges = false});
+  broken.draw(pair.polys());
+  EXPECT_TRUE(broken.hidden(behind)) << "the band along the whole edge should reach past B";
+}
+
+// Rule 11: a fragment of the band may be B's, at B's depth. B runs steeply
+// away (from 5 to 50 over a texel), A faces the eye at 5; the centre (5.5,
+// 4.5) lies 0.01 texel inside B, where B is farther than a box at 5.02: the
+// box is visible there. A's plane alone would hide it.
+TEST(OcclusionBufferFusion, TheBandTakesTheFartherOfBothPolygonsDepths) {
+  const Pair pair{5.49f, -2.0f, 11.0f, {4.0f, 4.5f, 5.0f}, {6.5f, 4.5f, 50.0f}};
+  const Aabb between = box(5.45f, 5.55f, 4.3f, 4.7f, 5.02f);
+  Sampled f(1);
+  f.draw(pair.polys());
+  EXPECT_FALSE(f.hidden(between));
+  EXPECT_TRUE(f.hidden(box(5.45f, 5.55f, 4.3f, 4.7f, 60.0f)));  // the band covers the centre
+  Sampled broken(1, {.fusion_depth = false});
+  broken.draw(pair.polys());
+  EXPECT_TRUE(broken.hidden(between)) << "A's plane should put the band in front of the box";
+}
+
+// Rule 11: both polygons must surely be drawn: a triangle whose orientation
+// any snapping by up to a step per corner (ours and the GPU's) could turn
+// is not fused. Checked against every such move of the corners of random
+// small triangles: accepted ones never turn, and some that are
+// counter-clockwise as they stand are refused.
+TEST(FixedPoint, ATriangleSurelyFrontFacingStaysSoUnderSnapping) {
+  std::mt19937 rng(3);
+  int accepted = 0, refused_ccw = 0;
+  for (int round = 0; round < 4000; ++round) {
+    std::int64_t X[3], Y[3];
+    for (int i = 0; i < 3; ++i) X[i] = std::int64_t(rng() % 40), Y[i] = std::int64_t(rng() % 40);
+    const std::int64_t area2 = (X[1] - X[0]) * (Y[2] - Y[0]) - (X[2] - X[0]) * (Y[1] - Y[0]);
+    if (!detail::surely_front_facing(X, Y, 0, 1, 2)) {
+      refused_ccw += area2 > 0;
+      continue;
+    }
+    ++accepted;
+    for (int move = 0; move < 729; ++move) {  // each of the 6 coordinates moved by -1, 0 or +1
+      std::int64_t x[3], y[3];
+      int code = move;
+      for (int i = 0; i < 3; ++i) {
+        x[i] = X[i] + code % 3 - 1, code /= 3;
+        y[i] = Y[i] + code % 3 - 1, code /= 3;
+      }
+      ASSERT_GT((x[1] - x[0]) * (y[2] - y[0]) - (x[2] - x[0]) * (y[1] - y[0]), 0) << round << " " << move;
+    }
+  }
+  EXPECT_GT(accepted, 100);
+  EXPECT_GT(refused_ccw, 100);
 }

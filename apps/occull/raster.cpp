@@ -29,6 +29,7 @@ struct RasterArgs {
   int repeat = 5;
   double detail = 8.0;  // as soc.detail
   bool whole_texels = false;  // rules 3-5 over whole texels instead of pixel centres (rule 10)
+  bool no_fusion = false;     // each polygon alone (rule 11 off, as soc:fuse=off)
 };
 
 struct Job {
@@ -65,14 +66,17 @@ int cmd_raster(const RasterArgs& a) {
                         make_occluder_mesh(scene.mesh(o.mesh).positions, scene.mesh(o.mesh).indices, a.detail));
 
   fmt::print("scene {}, path {}, {} frames spread over the path, best of {} timings each; one core; "
-             "SIMD: {}; coverage: {}\n",
+             "SIMD: {}; coverage: {}; {}\n",
              a.scene, path.name(), a.frames, a.repeat, simd_target_name(),
-             a.whole_texels ? "whole texels" : "pixel centres (a view of the buffer's size)");
+             a.whole_texels ? "whole texels" : "pixel centres (a view of the buffer's size)",
+             a.no_fusion ? "each polygon alone" : "pairs sharing an edge fused");
   fmt::print("{:>10} {:>9} {:>9} {:>12} {:>12} {:>12} {:>12} {:>8}\n", "buffer", "submitted", "polygons", "simd ms", "scalar ms",
              "simd p/ms", "scalar p/ms", "ratio");
   using Clock = std::chrono::steady_clock;
   for (const auto& [w, h] : sizes) {
     OcclusionBuffer best(w, h, SimdPath::best), scalar(w, h, SimdPath::scalar);
+    best.set_fused_pairs(!a.no_fusion);
+    scalar.set_fused_pairs(!a.no_fusion);
     double t_best = 0.0, t_scalar = 0.0;
     std::uint64_t polygons = 0, submitted = 0;
     std::vector<Job> jobs;
@@ -117,7 +121,7 @@ int cmd_raster(const RasterArgs& a) {
   }
   fmt::print("submitted: polygons of the occluders in the frustum that could cover a texel from where the camera is; "
              "polygons: rasterized per frame (front-facing, in the buffer, wide enough to cover a texel); ms: per "
-             "frame; p/ms: polygons per millisecond\n");
+             "frame, fused pairs' bands included (--no-fusion: without them); p/ms: polygons per millisecond\n");
   return 0;
 }
 
@@ -139,6 +143,8 @@ Command add_raster(CLI::App& app) {
   ra->add_flag("--whole-texels", a->whole_texels,
                "cover whole texels (as for an MSAA view) instead of the pixel centres of a single-sampled view of the "
                "buffer's size");
+  ra->add_flag("--no-fusion", a->no_fusion,
+               "each polygon covers alone (as soc:fuse=off): the polygons sharing an edge are not fused (the buffer's rule 11)");
   return [a] { return cmd_raster(*a); };
 }
 

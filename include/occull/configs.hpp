@@ -136,6 +136,7 @@ struct SocConfig {
   int height = 0;  ///< explicit buffer height in texels; in [0, 8192], 0: from scale
   OccluderChoice occluders;
   bool simd = true;  ///< vectorised inner loops (off: the scalar reference, equal bit for bit)
+  bool fuse = true;  ///< fused pairs (OcclusionBuffer rule 11): polygons sharing an edge cover the seam between them
 };
 
 /// GPU-driven two-phase depth-pyramid culling; needs a backend with device

@@ -79,6 +79,32 @@
 //                                        (SampleCoverageOnlyForTheViewsOwnSampleGrid,
 //                                         AGapHoldingAPixelCentreKeepsWhatIsBehindItVisible,
 //                                         ABoxReachingAnUncoveredPixelCentreIsVisible)
+// 11. Fused pairs: rule 3 leaves the texels along an edge shared by two
+//     polygons to neither (a square within the growth of the edge is
+//     wholly inside neither), though the GPU draws each pixel centre there
+//     with one of them: a terrain or a split wall keeps a seam of lost
+//     occlusion at every edge. For each edge of a mesh shared by two
+//     polygons (OccluderMesh::neighbours: matched by position, each
+//     direction of the edge used once; anything else is not fused), the
+//     band of squares lying wholly on neither side of it is covered where a
+//     square lies, grown, strictly inside every other edge of both: on
+//     either side of the edge wherever the GPU's snapping puts it, it lies
+//     in one of the two. Only when both are drawn unclipped (in front of the
+//     near plane, within twice the viewport's extent: inside any GPU's
+//     guard band) and surely front-facing (each triangle the GPU draws of
+//     them counter-clockwise however snapping moves its corners by a
+//     fixed-point step; detail::surely_front_facing, tested on its own: the
+//     GPU's snapping is not modelled on the CPU). Its depth is the farther
+//     of the two: A's bound (rule 4) plus B's bias, plus the difference of
+//     their slopes over the square's reach from the edge, plus what both
+//     planes miss the shared corners by, grown along the edge as far as
+//     the band reaches past them; no farther than the farther polygon's
+//     farthest vertex. An optimisation on top of the rules
+//     (set_fused_pairs(false) leaves it out: covering less is always
+//     conservative, and each polygon alone costs less).
+//                                        (APixelCentreOnASharedEdgeIsCoveredByThePair,
+//                                         TheBandEndsAtBothPolygonsOtherEdges,
+//                                         TheBandTakesTheFartherOfBothPolygonsDepths)
 // The buffer is hierarchical: each tile of 8×8 texels keeps its farthest
 // key (refreshed when a test reads a tile written since), and a box whose
 // nearest depth is behind a tile's farthest needs no texel of that tile
@@ -122,6 +148,8 @@ struct OcclusionRules {
   bool depth_margin = true;         ///< rule 8; false: hidden when the box's depth is not nearer (ties hidden)
   bool tiles = true;                ///< false: no tile shortcut, every texel read (the answers must not change)
   bool sample_grid = true;          ///< rule 10; false: every view taken as single-sampled at width / buffer width
+  bool fusion_other_edges = true;   ///< rule 11; false: the band not bounded by either polygon's other edges
+  bool fusion_depth = true;         ///< rule 11; false: the band takes A's depth bound alone
 };
 }  // namespace detail
 
@@ -208,6 +236,12 @@ class OcclusionBuffer {
   /// are covered whole.
   [[nodiscard]] int pixels_per_texel() const noexcept { return pixels_; }
 
+  /// Rule 11, fused pairs, on (the default) or off: off, each polygon
+  /// covers alone, which hides less and costs less (where a mesh's polygons
+  /// are smaller than a texel's centres' square, pairs rarely hold one).
+  void set_fused_pairs(bool on) noexcept { fused_pairs_ = on; }
+  [[nodiscard]] bool fused_pairs() const noexcept { return fused_pairs_; }
+
   /// Rasterizes the triangles `indices` (3 per triangle) of `positions`,
   /// transformed by `object_to_clip` (view_proj * object transform), into
   /// the buffer. Returns the triangles rasterized (front-facing, not clipped
@@ -273,14 +307,29 @@ class OcclusionBuffer {
   /// Starts a call rasterizing polygons of `vertices` positions: no vertex
   /// transformed yet.
   void begin_vertices(std::size_t vertices);
-  void raster_mesh_polygon(std::span<const glm::vec3> positions, const OccluderMesh& mesh, std::size_t p,
-                           const glm::dmat4& object_to_clip, std::uint32_t& count);
-  void raster_clipped(ClipVertex* const* v, int n, std::uint32_t& count);
-  void raster_polygon(const glm::dvec3* v, int n, std::uint32_t& count);
-  void raster_snapped(const glm::dvec3* v, const std::int64_t* X, const std::int64_t* Y, int n, std::uint32_t& count);
   struct Edge;
   struct DepthPlane;
-  static constexpr int kMaxEdges = 9;  ///< edges of a region: a polygon clipped at 5 planes, or a fused pair (rule 11)
+  /// Points v[0, corners) at polygon p's corners, transformed and classified
+  /// (shared through the vertex cache, or in `local`).
+  ClipVertex* mesh_corners(std::span<const glm::vec3> positions, const OccluderMesh& mesh, std::size_t p,
+                           const glm::dmat4& object_to_clip, ClipVertex* local, ClipVertex** v);
+  /// Rasterizes polygon p, and the bands along its shared edges (rule 11).
+  void raster_mesh_polygon(std::span<const glm::vec3> positions, const OccluderMesh& mesh, std::size_t p,
+                           const glm::dmat4& object_to_clip, std::uint32_t& count);
+  struct TexelRect {
+    int x_lo, x_hi, y_lo, y_hi;
+  };
+  void fuse_edge(std::span<const glm::vec3> positions, const OccluderMesh& mesh, ClipVertex* const* v, int n, int k,
+                 std::uint32_t q, const TexelRect& r, const Edge* band, const glm::dmat4& object_to_clip);
+  bool drawn_whole(ClipVertex* const* c, int count) const;
+  static bool might_cover(const Edge* edges, int count, const TexelRect& r);
+  bool raster_clipped(ClipVertex* const* v, int n, std::uint32_t& count);
+  void raster_polygon(const glm::dvec3* v, int n, std::uint32_t& count);
+  void raster_snapped(const glm::dvec3* v, const std::int64_t* X, const std::int64_t* Y, int n, std::uint32_t& count);
+  static constexpr int kMaxEdges = 9;
+  /// A region of at most this many texels is tested texel by texel.
+  static constexpr int kFewTexels = 16;  ///< edges of a region: a polygon clipped at 5 planes, or a fused pair (rule 11)
+  [[nodiscard]] Edge make_edge(const std::int64_t* X, const std::int64_t* Y, int i, int j) const;
   int polygon_edges(const std::int64_t* X, const std::int64_t* Y, int n, Edge* edges) const;
   bool depth_plane(const glm::dvec3* v, int n, DepthPlane& out) const;
   void fill_region(const Edge* edges, int edge_count, int x_lo, int x_hi, int y_lo, int y_hi, const DepthPlane& plane);
@@ -295,6 +344,7 @@ class OcclusionBuffer {
   detail::OcclusionRules rules_;
   ClipSpace clip_;
   int pixels_ = 0;            // rule 10: pixel centres per texel side, 0: whole texels
+  bool fused_pairs_ = true;   // rule 11
   std::int64_t inset_ = 0;    // rule 10: fixed-point steps from a texel's side to its centres' square
   std::vector<float> keys_;
   std::vector<float> tile_far_;

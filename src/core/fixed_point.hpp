@@ -40,4 +40,22 @@ namespace occull::detail {
   return std::bit_cast<float>(x > 0.0f ? bits + 1 : bits - 1);
 }
 
+/// Rule 11 (occull/occlusion_buffer.hpp): whether the triangle of corners
+/// i, j, k of X, Y (fixed point, 256 steps a texel) is counter-clockwise
+/// however each corner moves by up to one step on each axis (ours and the
+/// GPU's snapping together): twice its area exceeds what such moves can
+/// change it by (2 (|ab|_1 + |ac|_1) + 8).
+[[nodiscard]] inline bool surely_front_facing(const std::int64_t* X, const std::int64_t* Y, int i, int j, int k) {
+  const std::int64_t ax = X[j] - X[i], ay = Y[j] - Y[i], bx = X[k] - X[i], by = Y[k] - Y[i];
+  const std::int64_t area2 = ax * by - bx * ay;
+  const auto abs = [](std::int64_t v) { return v < 0 ? -v : v; };
+  return area2 > 4 * (abs(ax) + abs(ay) + abs(bx) + abs(by)) + 16;
+}
+/// Every triangle a GPU draws of polygon X, Y (n = 3 or 4 corners; a quad's
+/// two share corners 0 and 2, the diagonal OccluderMesh merges along)
+/// surely counter-clockwise.
+[[nodiscard]] inline bool surely_front_facing(const std::int64_t* X, const std::int64_t* Y, int n) {
+  return surely_front_facing(X, Y, 0, 1, 2) && (n == 3 || surely_front_facing(X, Y, 0, 2, 3));
+}
+
 }  // namespace occull::detail

@@ -46,6 +46,7 @@ constexpr double kGrowTexels = double(kGrow) / double(kSub);
 using detail::floor_div;
 using detail::floor_div_bounded;
 using detail::next_up;
+using detail::surely_front_facing;
 
 // A texel coordinate to the nearest 1/256 texel (ties to even), for |v| <
 // 2^20: adding 1.5 * 2^52 leaves no fraction bits in the sum, and the
@@ -78,6 +79,25 @@ bool behind(float nearest, float farthest, bool margin) {
 }  // namespace
 
 std::string simd_target_name() { return simd::target_name(); }
+
+// An edge function of a region: a texel is inside when
+// a * (x + ox) + b * (y + oy) + c > 0 (x, y its lower left corner, fixed
+// point; ox, oy the corner of its square tested; >= 0 with rule 3 off).
+struct OcclusionBuffer::Edge {
+  std::int64_t a, b, c, ox, oy;
+};
+
+// A region's depth bound: the plane through p0 with slopes gx, gy (per
+// texel), taken at (fx, fy) in each texel, plus bias, no farther than cap.
+struct OcclusionBuffer::DepthPlane {
+  glm::dvec3 p0;
+  double gx, gy, fx, fy, bias, off_plane;
+  float cap;
+};
+
+// The edges of a counter-clockwise polygon snapped to X, Y (those between
+// corners snapped together left out), each tested at the corner of the grown
+// texel (rule 10: centres' square) farthest outside it. Returns how many.
 
 std::size_t OccluderMesh::count_at_least(float radius) const noexcept {
   return std::size_t(std::partition_point(inradius.begin(), inradius.end(), [&](float r) { return r >= radius; }) -
@@ -276,7 +296,7 @@ std::uint32_t OcclusionBuffer::rasterize(std::span<const glm::vec3> positions, s
       c[k] = classify(object_to_clip * glm::dvec4(glm::dvec3(positions[indices[i + std::size_t(k)]]), 1.0));
     }
     ClipVertex* v[3] = {&c[0], &c[1], &c[2]};
-    raster_clipped(v, 3, count);
+    (void)raster_clipped(v, 3, count);
   }
   return count;
 }
@@ -345,7 +365,8 @@ std::uint32_t OcclusionBuffer::rasterize(std::span<const glm::vec3> positions, c
   }
   std::uint32_t drawn = 0;
   if (mesh.shared_corners) begin_vertices(positions.size());
-  for (std::size_t i = 0; i < chosen; ++i) raster_mesh_polygon(positions, mesh, chosen_[i], object_to_clip, drawn);
+  for (std::size_t i = 0; i < chosen; ++i)
+    raster_mesh_polygon(positions, mesh, chosen_[i], object_to_clip, drawn);
   return drawn;
 }
 
@@ -360,29 +381,149 @@ void OcclusionBuffer::begin_vertices(std::size_t vertices) {
   }
 }
 
-void OcclusionBuffer::raster_mesh_polygon(std::span<const glm::vec3> positions, const OccluderMesh& mesh,
-                                          std::size_t p, const glm::dmat4& object_to_clip, std::uint32_t& count) {
+OcclusionBuffer::ClipVertex* OcclusionBuffer::mesh_corners(std::span<const glm::vec3> positions,
+                                                           const OccluderMesh& mesh, std::size_t p,
+                                                           const glm::dmat4& object_to_clip, ClipVertex* local,
+                                                           ClipVertex** v) {
   const std::uint32_t* corners = mesh.corners.data() + 4 * p;
   const int n = corners[3] == OccluderMesh::no_corner ? 3 : 4;
-  ClipVertex* v[4];
-  if (!mesh.shared_corners) {  // each corner its own vertex: nothing to share
-    ClipVertex c[4];
-    for (int k = 0; k < n; ++k) {
-      c[k] = classify(object_to_clip * glm::dvec4(glm::dvec3(positions[corners[k]]), 1.0));
-      v[k] = &c[k];
-    }
-    raster_clipped(v, n, count);
-    return;
-  }
   for (int k = 0; k < n; ++k) {
     const std::uint32_t i = corners[k];
+    if (!mesh.shared_corners) {  // each corner its own vertex: nothing to share
+      local[k] = classify(object_to_clip * glm::dvec4(glm::dvec3(positions[i]), 1.0));
+      v[k] = &local[k];
+      continue;
+    }
     if (vertex_stamp_[i] != stamp_) {
       vertices_[i] = classify(object_to_clip * glm::dvec4(glm::dvec3(positions[i]), 1.0));
       vertex_stamp_[i] = stamp_;
     }
     v[k] = &vertices_[i];
   }
-  raster_clipped(v, n, count);
+  return v[0];
+}
+
+void OcclusionBuffer::raster_mesh_polygon(std::span<const glm::vec3> positions, const OccluderMesh& mesh,
+                                          std::size_t p, const glm::dmat4& object_to_clip,
+                                          std::uint32_t& count) {
+  const int n = mesh.corners[4 * p + 3] == OccluderMesh::no_corner ? 3 : 4;
+  ClipVertex local[4];
+  ClipVertex* v[4];
+  mesh_corners(positions, mesh, p, object_to_clip, local, v);
+  // Rule 11 (which rests on rules 2-4: none of them switched off).
+  if (!raster_clipped(v, n, count) || !fused_pairs_ || mesh.neighbours.empty() || !rules_.inner_coverage ||
+      !rules_.farthest_depth || !drawn_whole(v, n))
+    return;
+  // Each edge this polygon shares with an earlier polygon of the mesh (one
+  // this call may rasterize too: one too small to cover a texel alone adds
+  // little beside a larger one), so each pair once; only where a square of
+  // the band can lie: one reaching the edge's rectangle grown by the growth
+  // (a smaller region than the band hides less). At one pixel a texel most
+  // edges hold no pixel centre in their band, and stop here.
+  const std::int64_t near_side = inset_ - kGrow, far_side = kSub - inset_ + kGrow;
+  for (int k = 0; k < n; ++k) {
+    const std::uint32_t q = mesh.neighbours[4 * p + std::size_t(k)];
+    if (q >= p) continue;  // no_corner too
+    const ClipVertex &a = *v[k], &b = *v[(k + 1) % n];
+    const TexelRect r{int(std::max<std::int64_t>(0, -floor_div(far_side - (std::min(a.x, b.x) - kGrow), kSub))),
+                      int(std::min<std::int64_t>(width_ - 1, floor_div(std::max(a.x, b.x) + kGrow - near_side, kSub))),
+                      int(std::max<std::int64_t>(0, -floor_div(far_side - (std::min(a.y, b.y) - kGrow), kSub))),
+                      int(std::min<std::int64_t>(height_ - 1, floor_div(std::max(a.y, b.y) + kGrow - near_side, kSub)))};
+    if (r.x_lo > r.x_hi || r.y_lo > r.y_hi || (a.x == b.x && a.y == b.y)) continue;
+    // The band: squares that lie wholly on neither side of the shared edge
+    // (grown), i.e. that neither polygon alone covers; B's side of the edge
+    // is A's turned round, tested at B's farthest corner.
+    const std::int64_t X[2] = {a.x, b.x}, Y[2] = {a.y, b.y};
+    const Edge shared = make_edge(X, Y, 0, 1);
+    const Edge band[2] = {{-shared.a, -shared.b, -shared.c + 1, shared.ox, shared.oy},
+                          {shared.a, shared.b, shared.c + 1, -shared.a > 0 ? near_side : far_side,
+                           -shared.b > 0 ? near_side : far_side}};
+    if (might_cover(band, 2, r)) fuse_edge(positions, mesh, v, n, k, q, r, band, object_to_clip);
+  }
+}
+
+// Whether polygon corners c lie where the GPU draws them unclipped (inside
+// the near plane, and within twice the viewport's extent, well inside any
+// GPU's guard band); projected then.
+bool OcclusionBuffer::drawn_whole(ClipVertex* const* c, int count) const {
+  for (int i = 0; i < count; ++i) {
+    const glm::dvec4& x = c[i]->clip;
+    if (!c[i]->inside || !(std::abs(x.x) <= 2.0 * x.w) || !(std::abs(x.y) <= 2.0 * x.w)) return false;
+    project_once(*c[i]);
+  }
+  return true;
+}
+
+// False when no texel of a rectangle of a few texels lies inside every edge
+// (strictly: rule 3); true for a larger one, whose rows fill_region bounds
+// without testing each texel.
+bool OcclusionBuffer::might_cover(const Edge* edges, int count, const TexelRect& r) {
+  if ((r.x_hi - r.x_lo + 1) * (r.y_hi - r.y_lo + 1) > kFewTexels) return true;
+  for (std::int64_t ty = r.y_lo; ty <= r.y_hi; ++ty)
+    for (std::int64_t tx = r.x_lo; tx <= r.x_hi; ++tx) {
+      bool inside = true;
+      for (int e = 0; e < count && inside; ++e)
+        inside = edges[e].a * (tx * kSub + edges[e].ox) + edges[e].b * (ty * kSub + edges[e].oy) + edges[e].c > 0;
+      if (inside) return true;
+    }
+  return false;
+}
+
+// Rule 11: the band along the edge k of polygon A (corners v) that it shares
+// with polygon q (B).
+void OcclusionBuffer::fuse_edge(std::span<const glm::vec3> positions, const OccluderMesh& mesh, ClipVertex* const* v,
+                                int n, int k, std::uint32_t q, const TexelRect& r, const Edge* band,
+                                const glm::dmat4& object_to_clip) {
+  const int k1 = (k + 1) % n;
+  std::int64_t XA[4], YA[4];
+  for (int i = 0; i < n; ++i) XA[i] = v[i]->x, YA[i] = v[i]->y;
+  // Inside A's other edges and B's, grown: on A's side of the shared edge
+  // that is inside A, on B's inside B, wherever the GPU's snapping puts it.
+  // A's first: a band holding no square inside them stops before B is read.
+  Edge edges[kMaxEdges] = {band[0], band[1]};
+  int count = 2;
+  for (int i = 0; i < n && rules_.fusion_other_edges; ++i) {
+    const int i1 = (i + 1) % n;
+    if (i != k && !(XA[i] == XA[i1] && YA[i] == YA[i1])) edges[count++] = make_edge(XA, YA, i, i1);
+  }
+  if (!might_cover(edges, count, r)) return;
+
+  const int m = mesh.corners[4 * std::size_t(q) + 3] == OccluderMesh::no_corner ? 3 : 4;
+  ClipVertex local[4];
+  ClipVertex* w[4];
+  mesh_corners(positions, mesh, q, object_to_clip, local, w);
+  if (!drawn_whole(w, m)) return;
+  std::int64_t XB[4], YB[4];
+  glm::dvec3 sA[4], sB[4];
+  for (int i = 0; i < n; ++i) sA[i] = v[i]->window;
+  for (int i = 0; i < m; ++i) XB[i] = w[i]->x, YB[i] = w[i]->y, sB[i] = w[i]->window;
+  // B's edge j runs back along A's edge k (the same positions snap alike).
+  int j = -1;
+  for (int i = 0; i < m; ++i)
+    if (XB[i] == XA[k1] && YB[i] == YA[k1] && XB[(i + 1) % m] == XA[k] && YB[(i + 1) % m] == YA[k]) j = i;
+  if (j < 0) return;
+  if (!(surely_front_facing(XA, YA, n) && surely_front_facing(XB, YB, m))) return;
+  for (int i = 0; i < m && rules_.fusion_other_edges; ++i) {
+    const int i1 = (i + 1) % m;
+    if (i != j && !(XB[i] == XB[i1] && YB[i] == YB[i1])) edges[count++] = make_edge(XB, YB, i, i1);
+  }
+  DepthPlane plane, other;
+  if (!depth_plane(sA, n, plane) || !depth_plane(sB, m, other)) return;
+  const double length = glm::length(glm::dvec2(sA[k1].x - sA[k].x, sA[k1].y - sA[k].y));  // texels
+  if (!(length >= 1.0 / 64.0)) return;
+  if (rules_.fusion_depth) {
+    // A fragment of the band is A's or B's: B's plane differs from A's by
+    // their slopes' difference times the distance to the edge (no more than
+    // the grown square's diagonal), plus what both planes miss the shared
+    // corners by, which grows along the edge as far as the band's squares
+    // reach past them (under 3 texels: the edge's rectangle grown by a
+    // square).
+    const double side = 1.0 - 2.0 * double(inset_) / double(kSub) + 2.0 * kGrowTexels;
+    plane.bias += other.bias + (std::abs(plane.gx - other.gx) + std::abs(plane.gy - other.gy)) * side * 1.5 +
+                  (plane.off_plane + other.off_plane) * (2.0 + 6.0 / length);
+    plane.cap = std::max(plane.cap, other.cap);
+  }
+  fill_region(edges, count, r.x_lo, r.x_hi, r.y_lo, r.y_hi, plane);
 }
 
 namespace {
@@ -424,8 +565,9 @@ void OcclusionBuffer::project_once(ClipVertex& v) const {
 }
 
 // Rule 1: clips a convex polygon at the near plane and the guard band (in
-// double, Sutherland-Hodgman), then rasterizes what is left.
-void OcclusionBuffer::raster_clipped(ClipVertex* const* v, int vertices, std::uint32_t& count) {
+// double, Sutherland-Hodgman), then rasterizes what is left. True when the
+// polygon needed no clipping and faces the eye (its corners projected).
+bool OcclusionBuffer::raster_clipped(ClipVertex* const* v, int vertices, std::uint32_t& count) {
   const double guard = guard_band(width_, height_);
   const double near_depth = clip_.near_depth();
   const auto distance = [&](const glm::dvec4& c, int plane) -> double {
@@ -451,11 +593,11 @@ void OcclusionBuffer::raster_clipped(ClipVertex* const* v, int vertices, std::ui
     crossing_near |= v[i]->crossing_near;
     inside &= v[i]->inside;
   }
-  if (all_out != 0) return;
+  if (all_out != 0) return false;
   if (!crossing_near && rules_.front_faces_only) {
     const glm::dvec3 a(v[0]->clip.x, v[0]->clip.y, v[0]->clip.w), b(v[1]->clip.x, v[1]->clip.y, v[1]->clip.w),
         c(v[2]->clip.x, v[2]->clip.y, v[2]->clip.w);
-    if (!(glm::dot(a, glm::cross(b, c)) > 0.0)) return;
+    if (!(glm::dot(a, glm::cross(b, c)) > 0.0)) return false;
   }
   glm::dvec3 s[kMax];
   if (inside) {  // most: no plane to clip at, and the corners are projected and snapped already
@@ -467,11 +609,12 @@ void OcclusionBuffer::raster_clipped(ClipVertex* const* v, int vertices, std::ui
     if (double area = 0.0; rules_.front_faces_only) {
       for (int i = 0; i < vertices; ++i)
         area += s[i].x * s[(i + 1) % vertices].y - s[(i + 1) % vertices].x * s[i].y;
-      if (area > 0.0) raster_snapped(s, X, Y, vertices, count);  // rule 2: front faces only
-      return;
+      if (!(area > 0.0)) return false;  // rule 2: front faces only
+      raster_snapped(s, X, Y, vertices, count);
+      return true;
     }
     raster_polygon(s, vertices, count);
-    return;
+    return false;
   }
   glm::dvec4 poly[kMax], next[kMax];
   int n = vertices;
@@ -484,7 +627,7 @@ void OcclusionBuffer::raster_clipped(ClipVertex* const* v, int vertices, std::ui
       any_out |= d[i] < 0.0;
       none_in &= d[i] < 0.0;
     }
-    if (none_in) return;
+    if (none_in) return false;
     if (!any_out) continue;
     int m = 0;
     for (int i = 0; i < n; ++i) {
@@ -497,6 +640,7 @@ void OcclusionBuffer::raster_clipped(ClipVertex* const* v, int vertices, std::ui
   }
   for (int i = 0; i < n; ++i) s[i] = project(poly[i]);
   raster_polygon(s, n, count);
+  return false;
 }
 
 void OcclusionBuffer::raster_polygon(const glm::dvec3* in, int n, std::uint32_t& count) {
@@ -521,39 +665,26 @@ void OcclusionBuffer::raster_polygon(const glm::dvec3* in, int n, std::uint32_t&
   raster_snapped(v, X, Y, n, count);
 }
 
-// An edge function of a region: a texel is inside when
-// a * (x + ox) + b * (y + oy) + c > 0 (x, y its lower left corner, fixed
-// point; ox, oy the corner of its square tested; >= 0 with rule 3 off).
-struct OcclusionBuffer::Edge {
-  std::int64_t a, b, c, ox, oy;
-};
+OcclusionBuffer::Edge OcclusionBuffer::make_edge(const std::int64_t* X, const std::int64_t* Y, int i, int j) const {
+  Edge e;
+  e.a = Y[i] - Y[j];
+  e.b = X[j] - X[i];
+  e.c = -(e.a * X[i] + e.b * Y[i]);
+  if (rules_.inner_coverage) {  // the grown texel's (rule 10: centres' square's) corner
+    e.ox = e.a > 0 ? inset_ - kGrow : kSub - inset_ + kGrow;
+    e.oy = e.b > 0 ? inset_ - kGrow : kSub - inset_ + kGrow;
+  } else {
+    e.ox = e.oy = kSub / 2;  // the texel's centre (rule 3 broken)
+  }
+  return e;
+}
 
-// A region's depth bound: the plane through p0 with slopes gx, gy (per
-// texel), taken at (fx, fy) in each texel, plus bias, no farther than cap.
-struct OcclusionBuffer::DepthPlane {
-  glm::dvec3 p0;
-  double gx, gy, fx, fy, bias, off_plane;
-  float cap;
-};
-
-// The edges of a counter-clockwise polygon snapped to X, Y (those between
-// corners snapped together left out), each tested at the corner of the grown
-// texel (rule 10: centres' square) farthest outside it. Returns how many.
 int OcclusionBuffer::polygon_edges(const std::int64_t* X, const std::int64_t* Y, int n, Edge* edges) const {
   int edge_count = 0;
   for (int i = 0; i < n; ++i) {
     const int j = (i + 1) % n;
     if (X[i] == X[j] && Y[i] == Y[j]) continue;  // snapped onto its neighbour
-    Edge& e = edges[edge_count++];
-    e.a = Y[i] - Y[j];
-    e.b = X[j] - X[i];
-    e.c = -(e.a * X[i] + e.b * Y[i]);
-    if (rules_.inner_coverage) {  // the grown texel's (rule 10: centres' square's) corner
-      e.ox = e.a > 0 ? inset_ - kGrow : kSub - inset_ + kGrow;
-      e.oy = e.b > 0 ? inset_ - kGrow : kSub - inset_ + kGrow;
-    } else {
-      e.ox = e.oy = kSub / 2;  // the texel's centre (rule 3 broken)
-    }
+    edges[edge_count++] = make_edge(X, Y, i, j);
   }
   return edge_count;
 }
@@ -640,7 +771,6 @@ void OcclusionBuffer::fill_region(const Edge* edges, int edge_count, int x_lo, i
   // and remainder, with no division per row.
   // A region over a few texels (most, at one pixel a texel) is cheaper
   // tested texel by texel: the same edge functions, no division.
-  constexpr int kFewTexels = 16;
   const bool few = (x_hi - x_lo + 1) * (y_hi - y_lo + 1) <= kFewTexels;
   struct Bound {
     int side;  // +1: a lower bound (s > 0), -1: an upper bound (s < 0), 0: the edge is horizontal

@@ -99,6 +99,7 @@ class SocCuller final : public Culler {
     const int h = config_.height > 0 ? config_.height : std::max(1, view.height / config_.scale);
     const SimdPath simd = config_.simd ? SimdPath::best : SimdPath::scalar;
     if (!buffer_ || buffer_->width() != w || buffer_->height() != h) buffer_.emplace(w, h, simd);
+    buffer_->set_fused_pairs(config_.fuse);
     return *buffer_;
   }
 
@@ -129,7 +130,10 @@ Registration soc_registration() {
           .real("detail", [](auto& c) -> auto& { return c.occluders.detail; }, 0.0, 1e6,
                 "an occluder's polygons whose inscribed circle is below 1/detail of its largest are not rasterized "
                 "(0: all)")
-          .flag("simd", &SocConfig::simd, "vectorised inner loops (off: the scalar reference, equal bit for bit)");
+          .flag("simd", &SocConfig::simd, "vectorised inner loops (off: the scalar reference, equal bit for bit)")
+          .flag("fuse", &SocConfig::fuse,
+                "polygons of an occluder that share an edge cover the seam between them (the buffer's rule 11; off: "
+                "each alone, cheaper where they are smaller than a texel)");
   return registered({"soc",
                      "software occlusion culling: a strictly conservative CPU occlusion buffer, occluders "
                      "rasterized front to back as they are met, no queries",
