@@ -679,7 +679,7 @@ OcclusionBuffer::Edge OcclusionBuffer::make_edge(const std::int64_t* X, const st
   return e;
 }
 
-int OcclusionBuffer::polygon_edges(const std::int64_t* X, const std::int64_t* Y, int n, Edge* edges) const {
+[[gnu::always_inline]] inline int OcclusionBuffer::polygon_edges(const std::int64_t* X, const std::int64_t* Y, int n, Edge* edges) const {
   int edge_count = 0;
   for (int i = 0; i < n; ++i) {
     const int j = (i + 1) % n;
@@ -693,7 +693,7 @@ int OcclusionBuffer::polygon_edges(const std::int64_t* X, const std::int64_t* Y,
 // triangle, at the grown texel's farthest corner; the bias covers float
 // evaluation and the other corners' distance off the plane. False for a
 // polygon with no area.
-bool OcclusionBuffer::depth_plane(const glm::dvec3* v, int n, DepthPlane& out) const {
+[[gnu::always_inline]] inline bool OcclusionBuffer::depth_plane(const glm::dvec3* v, int n, DepthPlane& out) const {
   int best = 1;
   double best_area = 0.0;
   for (int k = 1; k + 1 < n; ++k) {
@@ -761,7 +761,7 @@ void OcclusionBuffer::raster_snapped(const glm::dvec3* v, const std::int64_t* X,
 
 // Writes the depth bound into every texel of [x_lo, x_hi] × [y_lo, y_hi]
 // inside every edge.
-void OcclusionBuffer::fill_region(const Edge* edges, int edge_count, int x_lo, int x_hi, int y_lo, int y_hi,
+[[gnu::always_inline]] inline void OcclusionBuffer::fill_region(const Edge* edges, int edge_count, int x_lo, int x_hi, int y_lo, int y_hi,
                                   const DepthPlane& plane) {
   const bool strict = rules_.inner_coverage;
   const float step = float(plane.gx);
