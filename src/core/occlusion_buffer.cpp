@@ -14,7 +14,6 @@
 #include <cmath>
 #include <limits>
 #include <bit>
-#include <unordered_map>
 #include <utility>
 
 namespace occull {
@@ -55,6 +54,54 @@ std::int64_t snap(double v) {
   constexpr double kMagic = 6755399441055744.0;  // 1.5 * 2^52
   return std::int64_t((v * double(kSub) + kMagic) - kMagic);
 }
+
+// A hash table of 32-bit values by key, open addressing with linear
+// probing, for make_occluder_mesh's welding and edges: one allocation, no
+// node a key (std::unordered_map's made preparing a city's meshes take
+// 175 ms). Keys are never erased.
+template <class Key>
+class FlatTable {
+ public:
+  /// Room for `count` keys at most half full.
+  explicit FlatTable(std::size_t count)
+      : mask_(std::bit_ceil(std::max<std::size_t>(16, 2 * count)) - 1), slots_(mask_ + 1) {}
+  /// The value of `key`, and whether it was added (with `value`) by this call.
+  std::pair<std::uint32_t*, bool> emplace(const Key& key, std::uint32_t value) {
+    for (std::size_t i = hash(key) & mask_;; i = (i + 1) & mask_) {
+      Slot& s = slots_[i];
+      if (!s.used) {
+        s = {key, value, true};
+        return {&s.value, true};
+      }
+      if (s.key == key) return {&s.value, false};
+    }
+  }
+  /// The value of `key`, or null.
+  [[nodiscard]] std::uint32_t* find(const Key& key) {
+    for (std::size_t i = hash(key) & mask_;; i = (i + 1) & mask_) {
+      Slot& s = slots_[i];
+      if (!s.used) return nullptr;
+      if (s.key == key) return &s.value;
+    }
+  }
+
+ private:
+  struct Slot {
+    Key key{};
+    std::uint32_t value = 0;
+    bool used = false;
+  };
+  static std::size_t hash(std::uint64_t k) noexcept {  // a 64-bit finaliser (splitmix64's)
+    k = (k ^ (k >> 30)) * 0xbf58476d1ce4e5b9ull;
+    k = (k ^ (k >> 27)) * 0x94d049bb133111ebull;
+    return std::size_t(k ^ (k >> 31));
+  }
+  static std::size_t hash(const std::array<std::uint32_t, 3>& k) noexcept {
+    return hash((std::uint64_t(k[0]) << 32 | k[1]) ^ (std::uint64_t(k[2]) * 0x9e3779b97f4a7c15ull));
+  }
+  std::size_t mask_;
+  std::vector<Slot> slots_;
+};
 
 // What choosing polygons needs of a lens on a width × height buffer: texels
 // per unit at unit view depth (the larger axis), and tan^2 of its half
@@ -118,27 +165,22 @@ OccluderMesh make_occluder_mesh(std::span<const glm::vec3> positions, std::span<
     t.normal = glm::cross(b - a, c - a);
     if (glm::length(t.normal) > 0.0) tris.push_back(t);
   }
-  // Directed edges by the bits of their end positions.
-  const auto bits = [&](std::uint32_t v) {
-    const glm::vec3& p = positions[v];
-    return std::array<float, 3>{p.x, p.y, p.z};
-  };
-  using Key = std::array<float, 6>;
-  struct Hash {
-    std::size_t operator()(const Key& k) const noexcept {
-      std::uint64_t h = 1469598103934665603ull;
-      for (float f : k) h = (h ^ std::bit_cast<std::uint32_t>(f)) * 1099511628211ull;
-      return std::size_t(h);
+  // Each position welded to an id by its bits (meshes that do not share
+  // vertices match too), and each directed edge keyed by its ends' ids.
+  std::vector<std::uint32_t> weld(positions.size());
+  {
+    FlatTable<std::array<std::uint32_t, 3>> ids(positions.size());
+    for (std::size_t v = 0; v < positions.size(); ++v) {
+      const glm::vec3& p = positions[v];
+      weld[v] = *ids.emplace({std::bit_cast<std::uint32_t>(p.x), std::bit_cast<std::uint32_t>(p.y),
+                              std::bit_cast<std::uint32_t>(p.z)},
+                             std::uint32_t(v)).first;
     }
-  };
-  const auto key = [&](std::uint32_t a, std::uint32_t b) {
-    const auto pa = bits(a), pb = bits(b);
-    return Key{pa[0], pa[1], pa[2], pb[0], pb[1], pb[2]};
-  };
-  std::unordered_map<Key, std::size_t, Hash> edges;
-  edges.reserve(tris.size() * 3);
+  }
+  const auto key = [&](std::uint32_t a, std::uint32_t b) { return std::uint64_t(weld[a]) << 32 | weld[b]; };
+  FlatTable<std::uint64_t> edges(tris.size() * 3);  // each directed edge's first triangle
   for (std::size_t t = 0; t < tris.size(); ++t)
-    for (int k = 0; k < 3; ++k) edges.emplace(key(tris[t].v[k], tris[t].v[(k + 1) % 3]), t);
+    for (int k = 0; k < 3; ++k) (void)edges.emplace(key(tris[t].v[k], tris[t].v[(k + 1) % 3]), std::uint32_t(t));
 
   struct Poly {
     std::uint32_t c[4];
@@ -173,14 +215,14 @@ OccluderMesh make_occluder_mesh(std::span<const glm::vec3> positions, std::span<
     bool done = false;
     for (int k = 0; k < 3 && !done; ++k) {
       const std::uint32_t a = tris[t].v[k], b = tris[t].v[(k + 1) % 3], c = tris[t].v[(k + 2) % 3];
-      const auto it = edges.find(key(b, a));
-      if (it == edges.end() || tris[it->second].merged) continue;
-      Tri& u = tris[it->second];
+      const std::uint32_t* across = edges.find(key(b, a));
+      if (across == nullptr || tris[*across].merged) continue;
+      Tri& u = tris[*across];
       const glm::dvec3 n1 = glm::normalize(tris[t].normal), n2 = glm::normalize(u.normal);
       if (glm::dot(n1, n2) < 1.0 - 1e-9) continue;  // not one plane
       std::uint32_t d = u.v[0];
       for (std::uint32_t w : u.v)
-        if (bits(w) != bits(a) && bits(w) != bits(b)) d = w;
+        if (weld[w] != weld[a] && weld[w] != weld[b]) d = w;
       const std::uint32_t quad[4] = {a, d, b, c};
       bool convex = true;
       for (int q = 0; q < 4; ++q) {
@@ -211,24 +253,23 @@ OccluderMesh make_occluder_mesh(std::span<const glm::vec3> positions, std::span<
   // Rule 11's pairs: each directed edge's polygon, kept only when the mesh
   // uses that edge once in that direction.
   constexpr std::uint32_t kMany = OccluderMesh::no_corner;
-  std::unordered_map<Key, std::uint32_t, Hash> directed;
-  directed.reserve(out.corners.size());
+  FlatTable<std::uint64_t> directed(out.corners.size());
   const auto corner_count = [&](std::size_t p) { return out.corners[4 * p + 3] == OccluderMesh::no_corner ? 3 : 4; };
   for (std::size_t p = 0; p < out.polygons(); ++p)
     for (int k = 0, n = corner_count(p); k < n; ++k) {
-      const auto [it, added] = directed.emplace(key(out.corners[4 * p + std::size_t(k)],
-                                                    out.corners[4 * p + std::size_t((k + 1) % n)]),
-                                                std::uint32_t(p));
-      if (!added) it->second = kMany;
+      const auto [value, added] = directed.emplace(key(out.corners[4 * p + std::size_t(k)],
+                                                       out.corners[4 * p + std::size_t((k + 1) % n)]),
+                                                   std::uint32_t(p));
+      if (!added) *value = kMany;
     }
   out.neighbours.assign(out.corners.size(), OccluderMesh::no_corner);
   for (std::size_t p = 0; p < out.polygons(); ++p)
     for (int k = 0, n = corner_count(p); k < n; ++k) {
       const std::uint32_t a = out.corners[4 * p + std::size_t(k)], b = out.corners[4 * p + std::size_t((k + 1) % n)];
-      if (directed.at(key(a, b)) != std::uint32_t(p)) continue;  // this direction used twice
-      const auto across = directed.find(key(b, a));
-      if (across != directed.end() && across->second != kMany && across->second != std::uint32_t(p))
-        out.neighbours[4 * p + std::size_t(k)] = across->second;
+      if (*directed.find(key(a, b)) != std::uint32_t(p)) continue;  // this direction used twice
+      const std::uint32_t* across = directed.find(key(b, a));
+      if (across != nullptr && *across != kMany && *across != std::uint32_t(p))
+        out.neighbours[4 * p + std::size_t(k)] = *across;
     }
   std::vector<bool> used(positions.size(), false);
   std::size_t corners = 0, vertices = 0;
