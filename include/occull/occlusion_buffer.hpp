@@ -90,18 +90,19 @@
 //     square lies, grown, strictly inside every other edge of both: on
 //     either side of the edge wherever the GPU's snapping puts it, it lies
 //     in one of the two. Only when both are drawn unclipped (in front of the
-//     near plane, within twice the viewport's extent: inside any GPU's
-//     guard band) and surely front-facing (each triangle the GPU draws of
-//     them counter-clockwise however snapping moves its corners by a
-//     fixed-point step; detail::surely_front_facing, tested on its own: the
-//     GPU's snapping is not modelled on the CPU). Its depth is the farther
-//     of the two: A's bound (rule 4) plus B's bias, plus the difference of
-//     their slopes over the square's reach from the edge, plus what both
-//     planes miss the shared corners by, grown along the edge as far as
-//     the band reaches past them; no farther than the farther polygon's
-//     farthest vertex. An optimisation on top of the rules
-//     (set_fused_pairs(false) leaves it out: covering less is always
-//     conservative, and each polygon alone costs less).
+//     near plane, and within twice the viewport's extent, which assumes the
+//     GPU's guard band reaches that far) and surely front-facing (each
+//     triangle the GPU draws of them counter-clockwise however snapping
+//     moves its corners by a fixed-point step; detail::surely_front_facing,
+//     tested on its own: the GPU's snapping is not modelled on the CPU).
+//     Its depth is the farther of the two: one polygon's bound (rule 4)
+//     plus the other's bias, plus the difference of their slopes over the
+//     square's reach from the edge, plus what both planes miss the shared
+//     corners by, grown along the edge as far as the band reaches past
+//     them; no farther than the farther polygon's farthest vertex. An
+//     optimisation on top of the rules (set_fused_pairs(false) leaves it
+//     out: covering less is always conservative, and each polygon alone
+//     costs less).
 //                                        (APixelCentreOnASharedEdgeIsCoveredByThePair,
 //                                         TheBandEndsAtBothPolygonsOtherEdges,
 //                                         TheBandTakesTheFartherOfBothPolygonsDepths)
@@ -311,7 +312,7 @@ class OcclusionBuffer {
   struct DepthPlane;
   /// Points v[0, corners) at polygon p's corners, transformed and classified
   /// (shared through the vertex cache, or in `local`).
-  ClipVertex* mesh_corners(std::span<const glm::vec3> positions, const OccluderMesh& mesh, std::size_t p,
+  void mesh_corners(std::span<const glm::vec3> positions, const OccluderMesh& mesh, std::size_t p,
                            const glm::dmat4& object_to_clip, ClipVertex* local, ClipVertex** v);
   /// Rasterizes polygon p, and the bands along its shared edges (rule 11).
   void raster_mesh_polygon(std::span<const glm::vec3> positions, const OccluderMesh& mesh, std::size_t p,
@@ -326,9 +327,8 @@ class OcclusionBuffer {
   bool raster_clipped(ClipVertex* const* v, int n, std::uint32_t& count);
   void raster_polygon(const glm::dvec3* v, int n, std::uint32_t& count);
   void raster_snapped(const glm::dvec3* v, const std::int64_t* X, const std::int64_t* Y, int n, std::uint32_t& count);
-  static constexpr int kMaxEdges = 9;
-  /// A region of at most this many texels is tested texel by texel.
-  static constexpr int kFewTexels = 16;  ///< edges of a region: a polygon clipped at 5 planes, or a fused pair (rule 11)
+  static constexpr int kMaxEdges = 9;    ///< of a region: a polygon clipped at 5 planes, or a fused pair's band (rule 11)
+  static constexpr int kFewTexels = 16;  ///< a region of at most this many texels is tested texel by texel
   [[nodiscard]] Edge make_edge(const std::int64_t* X, const std::int64_t* Y, int i, int j) const;
   int polygon_edges(const std::int64_t* X, const std::int64_t* Y, int n, Edge* edges) const;
   bool depth_plane(const glm::dvec3* v, int n, DepthPlane& out) const;

@@ -422,10 +422,8 @@ void OcclusionBuffer::begin_vertices(std::size_t vertices) {
   }
 }
 
-OcclusionBuffer::ClipVertex* OcclusionBuffer::mesh_corners(std::span<const glm::vec3> positions,
-                                                           const OccluderMesh& mesh, std::size_t p,
-                                                           const glm::dmat4& object_to_clip, ClipVertex* local,
-                                                           ClipVertex** v) {
+void OcclusionBuffer::mesh_corners(std::span<const glm::vec3> positions, const OccluderMesh& mesh, std::size_t p,
+                                   const glm::dmat4& object_to_clip, ClipVertex* local, ClipVertex** v) {
   const std::uint32_t* corners = mesh.corners.data() + 4 * p;
   const int n = corners[3] == OccluderMesh::no_corner ? 3 : 4;
   for (int k = 0; k < n; ++k) {
@@ -441,7 +439,6 @@ OcclusionBuffer::ClipVertex* OcclusionBuffer::mesh_corners(std::span<const glm::
     }
     v[k] = &vertices_[i];
   }
-  return v[0];
 }
 
 void OcclusionBuffer::raster_mesh_polygon(std::span<const glm::vec3> positions, const OccluderMesh& mesh,
@@ -484,8 +481,8 @@ void OcclusionBuffer::raster_mesh_polygon(std::span<const glm::vec3> positions, 
 }
 
 // Whether polygon corners c lie where the GPU draws them unclipped (inside
-// the near plane, and within twice the viewport's extent, well inside any
-// GPU's guard band); projected then.
+// the near plane, and within twice the viewport's extent: rule 11 assumes
+// the GPU's guard band reaches that far); projected then.
 bool OcclusionBuffer::drawn_whole(ClipVertex* const* c, int count) const {
   for (int i = 0; i < count; ++i) {
     const glm::dvec4& x = c[i]->clip;
