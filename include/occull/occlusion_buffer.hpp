@@ -324,6 +324,7 @@ class OcclusionBuffer {
                  std::uint32_t q, const TexelRect& r, const Edge* band, const glm::dmat4& object_to_clip);
   bool drawn_whole(ClipVertex* const* c, int count) const;
   static bool might_cover(const Edge* edges, int count, const TexelRect& r);
+  static Edge not_wholly_inside(const Edge& e);
   bool raster_clipped(ClipVertex* const* v, int n, std::uint32_t& count);
   void raster_polygon(const glm::dvec3* v, int n, std::uint32_t& count);
   void raster_snapped(const glm::dvec3* v, const std::int64_t* X, const std::int64_t* Y, int n, std::uint32_t& count);
@@ -332,7 +333,7 @@ class OcclusionBuffer {
   [[nodiscard]] Edge make_edge(const std::int64_t* X, const std::int64_t* Y, int i, int j) const;
   int polygon_edges(const std::int64_t* X, const std::int64_t* Y, int n, Edge* edges) const;
   bool depth_plane(const glm::dvec3* v, int n, DepthPlane& out) const;
-  void fill_region(const Edge* edges, int edge_count, int x_lo, int x_hi, int y_lo, int y_hi, const DepthPlane& plane);
+  void fill_region(const Edge* edges, int edge_count, const TexelRect& r, const DepthPlane& plane);
   float tile_farthest(int tx, int ty);
   /// Half the side of what a texel must have inside a polygon to be covered
   /// (the texel, or with rule 10 its pixel centres' square), in texels.

@@ -57,8 +57,8 @@ std::int64_t snap(double v) {
 
 // A hash table of 32-bit values by key, open addressing with linear
 // probing, for make_occluder_mesh's welding and edges: one allocation, no
-// node a key (std::unordered_map's made preparing a city's meshes take
-// 175 ms). Keys are never erased.
+// node a key (docs/performance.md: preparing a city's meshes took twice as
+// long with std::unordered_map). Keys are never erased.
 template <class Key>
 class FlatTable {
  public:
@@ -67,22 +67,15 @@ class FlatTable {
       : mask_(std::bit_ceil(std::max<std::size_t>(16, 2 * count)) - 1), slots_(mask_ + 1) {}
   /// The value of `key`, and whether it was added (with `value`) by this call.
   std::pair<std::uint32_t*, bool> emplace(const Key& key, std::uint32_t value) {
-    for (std::size_t i = hash(key) & mask_;; i = (i + 1) & mask_) {
-      Slot& s = slots_[i];
-      if (!s.used) {
-        s = {key, value, true};
-        return {&s.value, true};
-      }
-      if (s.key == key) return {&s.value, false};
-    }
+    Slot& s = slot(key);
+    const bool added = !s.used;
+    if (added) s = {key, value, true};
+    return {&s.value, added};
   }
   /// The value of `key`, or null.
   [[nodiscard]] std::uint32_t* find(const Key& key) {
-    for (std::size_t i = hash(key) & mask_;; i = (i + 1) & mask_) {
-      Slot& s = slots_[i];
-      if (!s.used) return nullptr;
-      if (s.key == key) return &s.value;
-    }
+    Slot& s = slot(key);
+    return s.used ? &s.value : nullptr;
   }
 
  private:
@@ -98,6 +91,11 @@ class FlatTable {
   }
   static std::size_t hash(const std::array<std::uint32_t, 3>& k) noexcept {
     return hash((std::uint64_t(k[0]) << 32 | k[1]) ^ (std::uint64_t(k[2]) * 0x9e3779b97f4a7c15ull));
+  }
+  // The slot holding `key`, or the empty one where it would go.
+  Slot& slot(const Key& key) {
+    for (std::size_t i = hash(key) & mask_;; i = (i + 1) & mask_)
+      if (!slots_[i].used || slots_[i].key == key) return slots_[i];
   }
   std::size_t mask_;
   std::vector<Slot> slots_;
@@ -469,16 +467,17 @@ void OcclusionBuffer::raster_mesh_polygon(std::span<const glm::vec3> positions, 
                       int(std::min<std::int64_t>(height_ - 1, floor_div(std::max(a.y, b.y) + kGrow - near_side, kSub)))};
     if (r.x_lo > r.x_hi || r.y_lo > r.y_hi || (a.x == b.x && a.y == b.y)) continue;
     // The band: squares that lie wholly on neither side of the shared edge
-    // (grown), i.e. that neither polygon alone covers; B's side of the edge
-    // is A's turned round, tested at B's farthest corner.
+    // (grown), i.e. that neither polygon alone covers: not wholly inside
+    // the edge as this polygon runs it, nor as the other runs it back.
     const std::int64_t X[2] = {a.x, b.x}, Y[2] = {a.y, b.y};
-    const Edge shared = make_edge(X, Y, 0, 1);
-    const Edge band[2] = {{-shared.a, -shared.b, -shared.c + 1, shared.ox, shared.oy},
-                          {shared.a, shared.b, shared.c + 1, -shared.a > 0 ? near_side : far_side,
-                           -shared.b > 0 ? near_side : far_side}};
+    const Edge band[2] = {not_wholly_inside(make_edge(X, Y, 0, 1)), not_wholly_inside(make_edge(X, Y, 1, 0))};
     if (might_cover(band, 2, r)) fuse_edge(positions, mesh, v, n, k, q, r, band, object_to_clip);
   }
 }
+
+// The squares that are not wholly inside edge e (grown): e at the corner
+// farthest outside it, e(corner) <= 0, is -e(corner) + 1 > 0.
+OcclusionBuffer::Edge OcclusionBuffer::not_wholly_inside(const Edge& e) { return {-e.a, -e.b, -e.c + 1, e.ox, e.oy}; }
 
 // Whether polygon corners c lie where the GPU draws them unclipped (inside
 // the near plane, and within twice the viewport's extent: rule 11 assumes
@@ -561,7 +560,7 @@ void OcclusionBuffer::fuse_edge(std::span<const glm::vec3> positions, const Occl
                   (plane.off_plane + other.off_plane) * (2.0 + 6.0 / length);
     plane.cap = std::max(plane.cap, other.cap);
   }
-  fill_region(edges, count, r.x_lo, r.x_hi, r.y_lo, r.y_hi, plane);
+  fill_region(edges, count, r, plane);
 }
 
 namespace {
@@ -794,13 +793,14 @@ void OcclusionBuffer::raster_snapped(const glm::dvec3* v, const std::int64_t* X,
   const int edge_count = polygon_edges(X, Y, n, edges);
   DepthPlane plane;
   if (!depth_plane(v, n, plane)) return;
-  fill_region(edges, edge_count, x_lo, x_hi, y_lo, y_hi, plane);
+  fill_region(edges, edge_count, {x_lo, x_hi, y_lo, y_hi}, plane);
 }
 
-// Writes the depth bound into every texel of [x_lo, x_hi] × [y_lo, y_hi]
+// Writes the depth bound into every texel of r
 // inside every edge.
-[[gnu::always_inline]] inline void OcclusionBuffer::fill_region(const Edge* edges, int edge_count, int x_lo, int x_hi, int y_lo, int y_hi,
-                                  const DepthPlane& plane) {
+[[gnu::always_inline]] inline void OcclusionBuffer::fill_region(const Edge* edges, int edge_count, const TexelRect& r,
+                                                                 const DepthPlane& plane) {
+  const int x_lo = r.x_lo, x_hi = r.x_hi, y_lo = r.y_lo, y_hi = r.y_hi;
   const bool strict = rules_.inner_coverage;
   const float step = float(plane.gx);
   // Each edge bounds a row's covered texels on one side: e(tx) = s*tx + r(ty),

@@ -519,10 +519,10 @@ class AutoCuller final : public Culler {
   // hid, which would fail the depth test, and the culler's query waits (the
   // device drawing what it was given, which vfc's frame pays too, and any
   // stall: taken out, they left llvmpipe's drawing at 1280x720 unpriced and
-  // vfc took over at a tenth of its cost: VfcsEstimatePricesQueryWaitsAsDrawing). It spares a try where
-  // vfc would lose by far (a dense city), and switches to vfc where even so
-  // it is cheaper than the current by the margin (open ground, where the
-  // culler hides little and its own CPU is what it adds).
+  // vfc took over at a tenth of its cost; VfcsEstimatePricesQueryWaitsAsDrawing).
+  // It spares a try where vfc would lose by far (a dense city), and switches
+  // to vfc where even so it is cheaper than the current by the margin (open
+  // ground, where the culler hides little and its own CPU is what it adds).
   void finished(const FrameMeasure& measured) {
     awaiting_feedback_ = false;
     const double drawn = double(measured.triangles) + kTrianglesPerDraw * double(measured.draw_calls);
