@@ -10,6 +10,7 @@
 
 #include <algorithm>
 #include <map>
+#include <string>
 #include <string_view>
 
 using namespace occull;
@@ -189,6 +190,72 @@ TEST(Soc, AnInteriorNodeShownLastFrameIsNotTestedAgainButItsObjectsAre) {
   const auto [expected, fresh_tests] = frame(*fresh);
   EXPECT_EQ(expected, std::vector<ObjectId>{0});
   EXPECT_EQ(third, expected);
+}
+
+// soc:prepass=on rasterizes last frame's occluders before its walk, so it
+// must draw them whatever the walk finds (a rasterized occluder that is not
+// drawn could hide what lies behind it on screen), and carries into the next
+// prepass only those its walk found visible again. A back wall is seen,
+// then a front wall moves in front of it: the back wall is drawn once more
+// (prepassed), then no longer. Without the prepass it is not drawn at once.
+TEST(Soc, ThePrepassDrawsLastFramesOccludersAndCarriesOnlyThoseFoundVisible) {
+  Scene scene = test::box_scene({{{-40, -40, -11}, {40, 40, -10}},   // 0: the front wall, moved aside at first
+                                 {{-20, -20, -31}, {20, 20, -30}}});  // 1: the back wall
+  const glm::mat4 aside = glm::translate(glm::mat4(1.0f), glm::vec3(500.0f, 0.0f, 0.0f));
+  Bvh bvh = Bvh::build(scene);
+  std::map<std::string, std::vector<std::vector<ObjectId>>> frames;
+  for (const char* spec : {"soc:prepass=on", "soc"}) {
+    scene.set_transform(0, aside);
+    bvh.refit(scene);
+    scene.clear_moved();
+    auto soc = make_culler(spec, {scene, bvh});
+    ScriptedBackend device;
+    for (int frame = 0; frame < 3; ++frame) {
+      if (frame == 1) {  // the front wall back in front of the back wall
+        scene.set_transform(0, glm::mat4(1.0f));
+        bvh.refit(scene);
+        scene.clear_moved();
+      }
+      device.rendered.clear();
+      (void)soc->render_frame(camera(), device);
+      std::sort(device.rendered.begin(), device.rendered.end());
+      frames[spec].push_back(device.rendered);
+    }
+  }
+  using Ids = std::vector<ObjectId>;
+  EXPECT_EQ(frames["soc:prepass=on"], (std::vector<Ids>{{1}, {0, 1}, {0}}));
+  EXPECT_EQ(frames["soc"], (std::vector<Ids>{{1}, {0}, {0}}));
+}
+
+// soc's threads (soc:threads, the buffer's own) share its prepass and its
+// occluders of many polygons: it draws what one thread draws, frame by frame.
+TEST(Soc, ThreadsDrawWhatOneThreadDraws) {
+  std::vector<Aabb> boxes;
+  for (int i = 0; i < 12; ++i)
+    for (int j = 0; j < 12; ++j) {
+      const float x = -30.0f + 5.0f * float(i), z = -8.0f - 5.0f * float(j), h = float((i * 7 + j * 3) % 5);
+      boxes.push_back({{x, -2.0f, z}, {x + 3.0f, h, z + 1.0f}});
+    }
+  const Scene scene = test::box_scene(boxes);
+  const Bvh bvh = Bvh::build(scene);
+  for (const char* scale : {"", ":scale=1"}) {
+    std::map<std::string, std::vector<std::vector<ObjectId>>> frames;
+    const std::string one = std::string("soc:prepass=on") + scale, three = one + ":threads=3";
+    for (const std::string& spec : {one, three}) {
+      auto soc = make_culler(spec, {scene, bvh});
+      ScriptedBackend device;
+      for (int frame = 0; frame < 6; ++frame) {
+        CameraPose pose;
+        pose.position = glm::vec3(0.5f * float(frame), 0.0f, 0.0f);
+        device.rendered.clear();
+        (void)soc->render_frame(make_view(pose, Lens{60.0f, 0.1f, 100.0f}, 320, 180), device);
+        std::sort(device.rendered.begin(), device.rendered.end());
+        frames[spec].push_back(device.rendered);
+      }
+    }
+    EXPECT_EQ(frames[three], frames[one]) << scale;
+    EXPECT_LT(frames[one].back().size(), boxes.size() / 2) << scale;  // it culls: rows hide rows
+  }
 }
 
 TEST(Soc, AnOccluderWithoutVerticesOnTheCpuHidesNothing) {

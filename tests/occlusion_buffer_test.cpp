@@ -6,6 +6,7 @@
 
 #include "core/fixed_point.hpp"
 #include "occull/depth_pyramid.hpp"
+#include "occull/error.hpp"
 #include "occull/view.hpp"
 
 #include <gtest/gtest.h>
@@ -83,6 +84,24 @@ Polys full_screen(float d) {
   Polys p;
   p.rect(-2.0f, 18.0f, -2.0f, 11.0f, d);
   return p;
+}
+
+// A bumpy terrain of 24 × 24 vertices 5 m apart, 2 m below the eye, from 5 m
+// behind it to 110 m ahead, no two triangles coplanar.
+Polys bumpy_terrain(std::mt19937& rng) {
+  std::uniform_real_distribution<float> bump(-1.0f, 1.0f);
+  constexpr int kSide = 24;
+  Polys t;
+  for (int z = 0; z < kSide; ++z)
+    for (int x = 0; x < kSide; ++x)
+      t.positions.emplace_back(-60.0f + 5.0f * float(x), -2.0f + 0.6f * bump(rng), 5.0f - 5.0f * float(z));
+  for (int z = 0; z + 1 < kSide; ++z)
+    for (int x = 0; x + 1 < kSide; ++x) {
+      const auto v = std::uint32_t(z * kSide + x);
+      // Counter-clockwise seen from above (+y): the terrain faces the sky.
+      t.indices.insert(t.indices.end(), {v, v + 1, v + kSide, v + 1, v + kSide + 1, v + kSide});
+    }
+  return t;
 }
 
 }  // namespace
@@ -491,19 +510,9 @@ TEST(OcclusionBuffer, SimdMatchesScalar) {
 // pixel centres.
 TEST(OcclusionBuffer, SharedVerticesRasterizeAsSeparateTriangles) {
   std::mt19937 rng(5);
-  std::uniform_real_distribution<float> bump(-1.0f, 1.0f);
-  constexpr int kSide = 24;
-  std::vector<glm::vec3> pos;
-  std::vector<std::uint32_t> idx;
-  for (int z = 0; z < kSide; ++z)
-    for (int x = 0; x < kSide; ++x)
-      pos.emplace_back(-60.0f + 5.0f * float(x), -2.0f + 0.6f * bump(rng), 5.0f - 5.0f * float(z));
-  for (int z = 0; z + 1 < kSide; ++z)
-    for (int x = 0; x + 1 < kSide; ++x) {
-      const auto v = std::uint32_t(z * kSide + x);
-      // Counter-clockwise seen from above (+y): the terrain faces the sky.
-      idx.insert(idx.end(), {v, v + 1, v + kSide, v + 1, v + kSide + 1, v + kSide});
-    }
+  const Polys terrain = bumpy_terrain(rng);
+  const std::vector<glm::vec3>& pos = terrain.positions;
+  const std::vector<std::uint32_t>& idx = terrain.indices;
   const OccluderMesh mesh = make_occluder_mesh(pos, idx);
   ASSERT_EQ(mesh.polygons(), idx.size() / 3);  // no quad merged
   ASSERT_TRUE(mesh.shared_corners);
@@ -528,6 +537,79 @@ TEST(OcclusionBuffer, SharedVerticesRasterizeAsSeparateTriangles) {
       ASSERT_EQ(std::bit_cast<std::uint32_t>(shared.keys()[i]), std::bit_cast<std::uint32_t>(one_by_one.keys()[i]))
           << "buffer " << shared.width() << "x" << shared.height() << " texel " << i;
   }
+}
+
+// Rasterizing on threads (set_threads) leaves the buffer as one thread does,
+// bit for bit: a bumpy terrain of 1,058 triangles (a call of enough polygons
+// to be shared among the threads) and 60 small slanted boxes, as one call each
+// and as one batch, at pixel centres and at whole texels; the polygon counts
+// agree too. Broken on purpose (the copies' keys not merged), it fails.
+TEST(OcclusionBuffer, ThreadsRasterizeAsOneDoes) {
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<float> bump(-1.0f, 1.0f), u(0.0f, 1.0f);
+  const Polys ground = bumpy_terrain(rng);
+  const std::vector<glm::vec3>& terrain = ground.positions;
+  const std::vector<std::uint32_t>& terrain_idx = ground.indices;
+  const OccluderMesh terrain_mesh = make_occluder_mesh(terrain, terrain_idx);
+  Polys boxes;  // a slanted quad each, drawn as its own object
+  for (int k = 0; k < 60; ++k) {
+    const float x0 = u(rng) * 15.0f, y0 = u(rng) * 8.0f, d = 2.0f + 30.0f * u(rng);
+    boxes.rect(x0, x0 + 0.5f + 3.0f * u(rng), y0, y0 + 0.5f + 2.0f * u(rng), d, d + 2.0f * bump(rng));
+  }
+  std::vector<OccluderMesh> quads;
+  for (std::size_t k = 0; k < boxes.indices.size(); k += 6)
+    quads.push_back(make_occluder_mesh(boxes.positions, std::span(boxes.indices).subspan(k, 6)));
+  const View view = camera();
+  std::vector<OcclusionBuffer::OccluderDraw> draws;
+  const auto bounds_of = [](std::span<const glm::vec3> p) {
+    Aabb b;
+    for (const glm::vec3& v : p) b.extend(v);
+    return b;
+  };
+  draws.push_back({terrain, &terrain_mesh, glm::mat4(1.0f), bounds_of(terrain)});
+  for (const OccluderMesh& q : quads) draws.push_back({boxes.positions, &q, glm::mat4(1.0f), bounds_of(boxes.positions)});
+  for (const int size : {1, 10}) {
+    OcclusionBuffer one(160 / size, 90 / size);
+    const auto start = [&](OcclusionBuffer& b) { size == 1 ? b.clear(view) : b.clear(view.clip); };
+    start(one);
+    std::uint32_t expected = 0;
+    for (const OcclusionBuffer::OccluderDraw& d : draws)
+      expected += one.rasterize(d.positions, *d.mesh, view, d.object_to_world, d.bounds);
+    ASSERT_GT(one.covered_texels(), one.keys().size() / 4) << size;  // the comparison compares something
+    for (const int threads : {2, 3}) {
+      OcclusionBuffer called(160 / size, 90 / size), batched(160 / size, 90 / size);
+      called.set_threads(threads);
+      batched.set_threads(threads);
+      EXPECT_EQ(batched.threads(), threads);
+      start(called);
+      start(batched);
+      std::uint32_t polygons = 0;
+      for (const OcclusionBuffer::OccluderDraw& d : draws)
+        polygons += called.rasterize(d.positions, *d.mesh, view, d.object_to_world, d.bounds);
+      EXPECT_EQ(polygons, expected);
+      EXPECT_EQ(batched.rasterize(draws, view), expected);
+      for (std::size_t i = 0; i < one.keys().size(); ++i) {
+        ASSERT_EQ(std::bit_cast<std::uint32_t>(called.keys()[i]), std::bit_cast<std::uint32_t>(one.keys()[i]))
+            << threads << " threads, one call a draw, buffer " << one.width() << " texel " << i;
+        ASSERT_EQ(std::bit_cast<std::uint32_t>(batched.keys()[i]), std::bit_cast<std::uint32_t>(one.keys()[i]))
+            << threads << " threads, one batch, buffer " << one.width() << " texel " << i;
+      }
+      // The box test answers from the merged keys as from one thread's.
+      int hidden = 0;
+      for (int k = 0; k < 200; ++k) {
+        const float x0 = u(rng) * 15.0f, y0 = u(rng) * 8.0f;
+        const Aabb b = box(x0, x0 + 0.3f, y0, y0 + 0.3f, 3.0f + 50.0f * u(rng), 1.0f);
+        const bool expected_hidden = one.occluded(b, view.view_proj);
+        hidden += expected_hidden;
+        ASSERT_EQ(batched.occluded(b, view.view_proj), expected_hidden) << threads << " threads, box " << k;
+        ASSERT_EQ(called.occluded(b, view.view_proj), expected_hidden) << threads << " threads, box " << k;
+      }
+      EXPECT_GT(hidden, 10);
+    }
+  }
+  OcclusionBuffer b(4, 4);
+  EXPECT_THROW(b.set_threads(0), UsageError);
+  EXPECT_THROW(b.set_threads(OcclusionBuffer::max_threads + 1), UsageError);
 }
 
 // The rasterizer's integer bounds divide without a 64-bit division where the

@@ -137,6 +137,8 @@ struct SocConfig {
   OccluderChoice occluders;
   bool simd = true;  ///< vectorised inner loops (off: the scalar reference, equal bit for bit)
   bool fuse = true;  ///< fused pairs (OcclusionBuffer rule 11): polygons sharing an edge cover the seam between them
+  int threads = 1;   ///< threads rasterizing an occluder of many polygons, and the prepass (OcclusionBuffer::set_threads); in [1, 64]
+  bool prepass = false;  ///< last frame's occluders still in the frustum rasterized first, as one batch, and drawn
 };
 
 /// GPU-driven two-phase depth-pyramid culling; needs a backend with device

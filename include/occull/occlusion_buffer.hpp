@@ -129,6 +129,7 @@
 #include <glm/mat4x4.hpp>
 
 #include <cstdint>
+#include <memory>
 #include <span>
 #include <string>
 #include <vector>
@@ -136,6 +137,7 @@
 namespace occull {
 
 namespace detail {
+class WorkerPool;
 /// The rules of the header, each switchable to show what breaks without it
 /// (tests only; the defaults are the conservative buffer).
 struct OcclusionRules {
@@ -210,16 +212,21 @@ struct OccluderMesh {
                                               std::span<const std::uint32_t> indices, double detail = 0.0);
 
 /// A width × height occlusion buffer over a viewport, and its box test.
-/// Not thread-safe; one per culler (and per view size).
+/// Not thread-safe; one per culler (and per view size). It may rasterize
+/// on threads of its own (set_threads).
 class OcclusionBuffer {
  public:
   static constexpr int tile_size = 8;  ///< texels per tile side
+  static constexpr int max_threads = 64;
 
   /// Throws UsageError unless 1 <= width, height <= 8192.
   OcclusionBuffer(int width, int height, SimdPath simd = SimdPath::best)
       : OcclusionBuffer(width, height, simd, detail::OcclusionRules{}) {}
   /// Tests only: a buffer with some rule of the header switched off.
   OcclusionBuffer(int width, int height, SimdPath simd, const detail::OcclusionRules& rules);
+  OcclusionBuffer(OcclusionBuffer&&) noexcept;
+  OcclusionBuffer& operator=(OcclusionBuffer&&) noexcept;
+  ~OcclusionBuffer();
 
   [[nodiscard]] int width() const noexcept { return width_; }
   [[nodiscard]] int height() const noexcept { return height_; }
@@ -243,6 +250,20 @@ class OcclusionBuffer {
   void set_fused_pairs(bool on) noexcept { fused_pairs_ = on; }
   [[nodiscard]] bool fused_pairs() const noexcept { return fused_pairs_; }
 
+  /// Rasterizes on `threads` threads: the caller's and threads - 1 that the
+  /// buffer starts and owns (1, the default: the caller's alone). A mesh
+  /// call with enough polygons (parallel_polygons) is shared among them in
+  /// small runs, each thread rasterizing into a copy of the buffer of its
+  /// own, and the copies are merged into the buffer, each texel keeping the
+  /// nearest key, before the call returns. Every texel keeps the nearest of
+  /// the same keys in any order: the buffer is the same bit for bit
+  /// whatever the threads (ThreadsRasterizeAsOneDoes). Throws UsageError
+  /// unless 1 <= threads <= max_threads.
+  void set_threads(int threads);
+  [[nodiscard]] int threads() const noexcept { return int(lanes_.size()); }
+  /// A mesh call rasterizing fewer polygons runs on the caller's thread alone.
+  static constexpr std::size_t parallel_polygons = 96;
+
   /// Rasterizes the triangles `indices` (3 per triangle) of `positions`,
   /// transformed by `object_to_clip` (view_proj * object transform), into
   /// the buffer. Returns the triangles rasterized (front-facing, not clipped
@@ -263,6 +284,19 @@ class OcclusionBuffer {
   /// polygons rasterized.
   std::uint32_t rasterize(std::span<const glm::vec3> positions, const OccluderMesh& mesh, const View& view,
                           const glm::mat4& object_to_world, const Aabb& bounds);
+
+  /// An occluder for the batch rasterize: what the one-object rasterize takes.
+  struct OccluderDraw {
+    std::span<const glm::vec3> positions;
+    const OccluderMesh* mesh;  ///< made from positions; not null
+    glm::mat4 object_to_world;
+    Aabb bounds;  ///< world space
+  };
+  /// Rasterizes each of `draws` as rasterize(positions, *mesh, view,
+  /// object_to_world, bounds) does, the draws shared among the buffer's
+  /// threads (set_threads): the buffer ends as after those calls one by
+  /// one, bit for bit. Returns the polygons rasterized.
+  std::uint32_t rasterize(std::span<const OccluderDraw> draws, const View& view);
 
   /// How many of `mesh`'s leading polygons can cover a texel whole on this
   /// buffer, for an object with transform `object_to_world` and world box
@@ -302,38 +336,65 @@ class OcclusionBuffer {
     bool projected;        // window, x and y are set
   };
   [[nodiscard]] ClipVertex classify(const glm::dvec4& clip) const;
+  /// What one thread writes while rasterizing: the texels' keys and the
+  /// tiles' written flags (the buffer's own for lane 0, a copy's for the
+  /// others), each vertex of the mesh being rasterized transformed and
+  /// projected once however many polygons share it (valid where its stamp
+  /// is `stamp`), and the polygons rasterized.
+  struct Lane {
+    float* keys = nullptr;
+    std::uint8_t* dirty = nullptr;
+    std::vector<float> own_keys;          // lanes past 0
+    std::vector<std::uint8_t> own_dirty;  // lanes past 0
+    std::vector<ClipVertex> vertices;
+    std::vector<std::uint32_t> vertex_stamp;
+    std::uint32_t stamp = 0;
+    std::uint32_t count = 0;
+    std::vector<std::uint32_t> chosen;  // a call's polygons to rasterize (scratch)
+  };
+  /// Fills `chosen` with the polygons of `mesh` that the view-based
+  /// rasterize rasterizes, in order; returns how many.
+  std::size_t choose_polygons(std::vector<std::uint32_t>& chosen, const OccluderMesh& mesh, const View& view,
+                              const glm::mat4& object_to_world, const Aabb& bounds) const;
+  /// Rasterizes polygons list[0, count) of `mesh` (list null: 0..count-1),
+  /// on every lane when there are enough of them. Returns how many were rasterized.
+  std::uint32_t raster_polygons(std::span<const glm::vec3> positions, const OccluderMesh& mesh,
+                                const std::uint32_t* list, std::size_t count, const glm::dmat4& object_to_clip);
+  /// Merges lane's keys into the buffer's (the nearest kept), and empties them.
+  void merge(Lane& lane);
   /// Sets v's window, x and y if not yet. Precondition: !v.crossing_near.
   void project_once(ClipVertex& v) const;
   [[nodiscard]] glm::dvec3 project(const glm::dvec4& clip) const;
-  /// Starts a call rasterizing polygons of `vertices` positions: no vertex
-  /// transformed yet.
-  void begin_vertices(std::size_t vertices);
+  /// Starts a call rasterizing polygons of `vertices` positions on `lane`:
+  /// no vertex transformed yet.
+  static void begin_vertices(Lane& lane, std::size_t vertices);
   struct Edge;
   struct DepthPlane;
   /// Points v[0, corners) at polygon p's corners, transformed and classified
   /// (shared through the vertex cache, or in `local`).
-  void mesh_corners(std::span<const glm::vec3> positions, const OccluderMesh& mesh, std::size_t p,
-                           const glm::dmat4& object_to_clip, ClipVertex* local, ClipVertex** v);
+  void mesh_corners(Lane& lane, std::span<const glm::vec3> positions, const OccluderMesh& mesh, std::size_t p,
+                    const glm::dmat4& object_to_clip, ClipVertex* local, ClipVertex** v) const;
   /// Rasterizes polygon p, and the bands along its shared edges (rule 11).
-  void raster_mesh_polygon(std::span<const glm::vec3> positions, const OccluderMesh& mesh, std::size_t p,
-                           const glm::dmat4& object_to_clip, std::uint32_t& count);
+  void raster_mesh_polygon(Lane& lane, std::span<const glm::vec3> positions, const OccluderMesh& mesh, std::size_t p,
+                           const glm::dmat4& object_to_clip) const;
   struct TexelRect {
     int x_lo, x_hi, y_lo, y_hi;
   };
-  void fuse_edge(std::span<const glm::vec3> positions, const OccluderMesh& mesh, ClipVertex* const* v, int n, int k,
-                 std::uint32_t q, const TexelRect& r, const Edge* band, const glm::dmat4& object_to_clip);
+  void fuse_edge(Lane& lane, std::span<const glm::vec3> positions, const OccluderMesh& mesh, ClipVertex* const* v,
+                 int n, int k, std::uint32_t q, const TexelRect& r, const Edge* band,
+                 const glm::dmat4& object_to_clip) const;
   bool drawn_whole(ClipVertex* const* c, int count) const;
   static bool might_cover(const Edge* edges, int count, const TexelRect& r);
   static Edge not_wholly_inside(const Edge& e);
-  bool raster_clipped(ClipVertex* const* v, int n, std::uint32_t& count);
-  void raster_polygon(const glm::dvec3* v, int n, std::uint32_t& count);
-  void raster_snapped(const glm::dvec3* v, const std::int64_t* X, const std::int64_t* Y, int n, std::uint32_t& count);
+  bool raster_clipped(Lane& lane, ClipVertex* const* v, int n) const;
+  void raster_polygon(Lane& lane, const glm::dvec3* v, int n) const;
+  void raster_snapped(Lane& lane, const glm::dvec3* v, const std::int64_t* X, const std::int64_t* Y, int n) const;
   static constexpr int kMaxEdges = 9;    ///< of a region: a polygon clipped at 5 planes, or a fused pair's band (rule 11)
   static constexpr int kFewTexels = 16;  ///< a region of at most this many texels is tested texel by texel
   [[nodiscard]] Edge make_edge(const std::int64_t* X, const std::int64_t* Y, int i, int j) const;
   int polygon_edges(const std::int64_t* X, const std::int64_t* Y, int n, Edge* edges) const;
   bool depth_plane(const glm::dvec3* v, int n, DepthPlane& out) const;
-  void fill_region(const Edge* edges, int edge_count, const TexelRect& r, const DepthPlane& plane);
+  void fill_region(Lane& lane, const Edge* edges, int edge_count, const TexelRect& r, const DepthPlane& plane) const;
   float tile_farthest(int tx, int ty);
   /// Half the side of what a texel must have inside a polygon to be covered
   /// (the texel, or with rule 10 its pixel centres' square), in texels.
@@ -350,12 +411,8 @@ class OcclusionBuffer {
   std::vector<float> keys_;
   std::vector<float> tile_far_;
   std::vector<std::uint8_t> tile_dirty_;
-  // Each vertex of the mesh being rasterized, transformed and projected once
-  // however many polygons share it: valid where its stamp is stamp_.
-  std::vector<ClipVertex> vertices_;
-  std::vector<std::uint32_t> vertex_stamp_;
-  std::uint32_t stamp_ = 0;
-  std::vector<std::uint32_t> chosen_;  // a call's polygons to rasterize (scratch)
+  std::vector<Lane> lanes_;                 // one a thread; lanes_[0] the caller's
+  std::unique_ptr<detail::WorkerPool> pool_;  // threads for lanes_[1...]; null with one lane
 };
 
 }  // namespace occull

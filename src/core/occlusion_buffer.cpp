@@ -7,9 +7,11 @@
 #include "occull/error.hpp"
 #include "core/format.hpp"
 #include "core/fixed_point.hpp"
+#include "core/worker_pool.hpp"
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cassert>
 #include <cmath>
 #include <limits>
@@ -289,9 +291,48 @@ OcclusionBuffer::OcclusionBuffer(int width, int height, SimdPath simd, const det
       rules_(rules),
       keys_(std::size_t(width) * std::size_t(height), kInf),
       tile_far_(std::size_t(tiles_x_) * std::size_t(tiles_y_), kInf),
-      tile_dirty_(tile_far_.size(), 0) {
+      tile_dirty_(tile_far_.size(), 0),
+      lanes_(1) {
   if (width < 1 || height < 1 || width > 8192 || height > 8192)
     throw UsageError(detail::format("OcclusionBuffer: {}x{} texels (each side in [1, 8192])", width, height));
+}
+
+OcclusionBuffer::OcclusionBuffer(OcclusionBuffer&&) noexcept = default;
+OcclusionBuffer& OcclusionBuffer::operator=(OcclusionBuffer&&) noexcept = default;
+OcclusionBuffer::~OcclusionBuffer() = default;
+
+void OcclusionBuffer::set_threads(int threads) {
+  if (threads < 1 || threads > max_threads)
+    throw UsageError(detail::format("OcclusionBuffer::set_threads: {} threads (in [1, {}])", threads, max_threads));
+  if (threads == this->threads()) return;
+  pool_.reset();  // joins the old threads before their lanes go
+  lanes_.resize(std::size_t(threads));
+  for (std::size_t i = 1; i < lanes_.size(); ++i) {
+    lanes_[i].own_keys.assign(keys_.size(), kInf);
+    lanes_[i].own_dirty.assign(tile_dirty_.size(), 0);
+  }
+  if (threads > 1) pool_ = std::make_unique<detail::WorkerPool>(threads - 1);
+}
+
+void OcclusionBuffer::merge(Lane& lane) {
+  for (int ty = 0; ty < tiles_y_; ++ty)
+    for (int tx = 0; tx < tiles_x_; ++tx) {
+      const std::size_t t = std::size_t(ty) * std::size_t(tiles_x_) + std::size_t(tx);
+      if (!lane.own_dirty[t]) continue;
+      lane.own_dirty[t] = 0;
+      tile_dirty_[t] = 1;
+      const int x0 = tx * tile_size, y0 = ty * tile_size;
+      const int w = std::min(tile_size, width_ - x0), h = std::min(tile_size, height_ - y0);
+      for (int y = y0; y < y0 + h; ++y) {
+        const std::size_t i = std::size_t(y) * std::size_t(width_) + std::size_t(x0);
+        float* to = keys_.data() + i;
+        float* from = lane.own_keys.data() + i;
+        for (int x = 0; x < w; ++x) {
+          to[x] = to[x] < from[x] ? to[x] : from[x];  // as fill_span keeps the nearer
+          from[x] = kInf;
+        }
+      }
+    }
 }
 
 void OcclusionBuffer::clear(const ClipSpace& clip) {
@@ -325,7 +366,8 @@ std::size_t OcclusionBuffer::covered_texels() const noexcept {
 
 std::uint32_t OcclusionBuffer::rasterize(std::span<const glm::vec3> positions, std::span<const std::uint32_t> indices,
                                          const glm::dmat4& object_to_clip) {
-  std::uint32_t count = 0;
+  Lane& lane = lanes_[0];
+  lane.keys = keys_.data(), lane.dirty = tile_dirty_.data(), lane.count = 0;
   for (std::size_t i = 0; i + 2 < indices.size(); i += 3) {
     ClipVertex c[3];
     for (int k = 0; k < 3; ++k) {
@@ -335,27 +377,69 @@ std::uint32_t OcclusionBuffer::rasterize(std::span<const glm::vec3> positions, s
       c[k] = classify(object_to_clip * glm::dvec4(glm::dvec3(positions[indices[i + std::size_t(k)]]), 1.0));
     }
     ClipVertex* v[3] = {&c[0], &c[1], &c[2]};
-    (void)raster_clipped(v, 3, count);
+    (void)raster_clipped(lane, v, 3);
   }
-  return count;
+  return lane.count;
 }
 
 std::uint32_t OcclusionBuffer::rasterize(std::span<const glm::vec3> positions, const OccluderMesh& mesh,
                                          std::size_t count, const glm::dmat4& object_to_clip) {
   if (count > mesh.polygons())
     throw UsageError(detail::format("OcclusionBuffer::rasterize: {} polygons of a mesh of {}", count, mesh.polygons()));
-  std::uint32_t drawn = 0;
-  if (mesh.shared_corners) begin_vertices(positions.size());
-  for (std::size_t p = 0; p < count; ++p) raster_mesh_polygon(positions, mesh, p, object_to_clip, drawn);
-  return drawn;
+  return raster_polygons(positions, mesh, nullptr, count, object_to_clip);
 }
 
 std::uint32_t OcclusionBuffer::rasterize(std::span<const glm::vec3> positions, const OccluderMesh& mesh,
                                          const View& view, const glm::mat4& object_to_world, const Aabb& bounds) {
-  const std::size_t count = polygons_worth_rasterizing(mesh, view, object_to_world, bounds);
+  Lane& lane = lanes_[0];
+  const std::size_t count = choose_polygons(lane.chosen, mesh, view, object_to_world, bounds);
   if (count == 0) return 0;
   const glm::dmat4 object_to_clip = glm::dmat4(view.view_proj) * glm::dmat4(object_to_world);
-  if (view.orthographic) return rasterize(positions, mesh, count, object_to_clip);
+  return raster_polygons(positions, mesh, lane.chosen.data(), count, object_to_clip);
+}
+
+std::uint32_t OcclusionBuffer::rasterize(std::span<const OccluderDraw> draws, const View& view) {
+  lanes_[0].keys = keys_.data(), lanes_[0].dirty = tile_dirty_.data();
+  for (std::size_t l = 1; l < lanes_.size(); ++l)
+    lanes_[l].keys = lanes_[l].own_keys.data(), lanes_[l].dirty = lanes_[l].own_dirty.data();
+  for (Lane& lane : lanes_) lane.count = 0;
+  // Each draw whole on one thread, taken in turn by whichever is free.
+  std::atomic<std::size_t> next{0};
+  auto job = [&](int l) {
+    Lane& lane = lanes_[std::size_t(l)];
+    for (std::size_t d = next.fetch_add(1, std::memory_order_relaxed); d < draws.size();
+         d = next.fetch_add(1, std::memory_order_relaxed)) {
+      const OccluderDraw& draw = draws[d];
+      const std::size_t count = choose_polygons(lane.chosen, *draw.mesh, view, draw.object_to_world, draw.bounds);
+      if (count == 0) continue;
+      const glm::dmat4 object_to_clip = glm::dmat4(view.view_proj) * glm::dmat4(draw.object_to_world);
+      if (draw.mesh->shared_corners) begin_vertices(lane, draw.positions.size());
+      for (std::size_t i = 0; i < count; ++i)
+        raster_mesh_polygon(lane, draw.positions, *draw.mesh, lane.chosen[i], object_to_clip);
+    }
+  };
+  if (pool_)
+    pool_->run(job);
+  else
+    job(0);
+  std::uint32_t drawn = lanes_[0].count;
+  for (std::size_t l = 1; l < lanes_.size(); ++l) {
+    merge(lanes_[l]);
+    drawn += lanes_[l].count;
+  }
+  return drawn;
+}
+
+std::size_t OcclusionBuffer::choose_polygons(std::vector<std::uint32_t>& list, const OccluderMesh& mesh,
+                                             const View& view, const glm::mat4& object_to_world,
+                                             const Aabb& bounds) const {
+  const std::size_t count = polygons_worth_rasterizing(mesh, view, object_to_world, bounds);
+  list.resize(count);
+  if (count == 0) return 0;
+  if (view.orthographic) {
+    for (std::size_t p = 0; p < count; ++p) list[p] = std::uint32_t(p);
+    return count;
+  }
   // Per polygon, in object space: its side of the eye; its size on the
   // buffer at the nearest view depth of its bounding sphere (a length at view
   // depth z spans at most f / z * sqrt(1 + tan^2) texels, f texels per unit
@@ -376,17 +460,15 @@ std::uint32_t OcclusionBuffer::rasterize(std::span<const glm::vec3> positions, c
   const double depth_stretch = glm::length(depth_axis);
   const double near = double(view.near);
   const double half_side = covered_half_side(), circle = 0.785 * 4.0 * half_side * half_side;  // pi/4 of the square
-  // The polygons chosen first, into a list with no branch a polygon (which
-  // side of the eye a terrain's polygon faces is a coin toss to the
-  // predictor), then rasterized in their order.
-  chosen_.resize(count);
+  // Into a list with no branch a polygon (which side of the eye a terrain's
+  // polygon faces is a coin toss to the predictor).
   std::size_t chosen = 0;
   const bool any_side = !rules_.front_faces_only;
   if (half_side <= 0.0) {  // rule 10, one pixel a texel: any polygon may hold a pixel centre
     for (std::size_t p = 0; p < count; ++p) {
       const OccluderMesh::Bounds& b = mesh.bounds[p];
       const double side = flip * (glm::dot(glm::dvec3(b.normal), eye) - double(b.offset));
-      chosen_[chosen] = std::uint32_t(p);
+      list[chosen] = std::uint32_t(p);
       chosen += std::size_t(any_side | (side > 0.0));
     }
   } else {
@@ -397,31 +479,66 @@ std::uint32_t OcclusionBuffer::rasterize(std::span<const glm::vec3> positions, c
       const double z = std::max(glm::dot(depth_axis, centre) + depth_offset - depth_stretch * double(b.radius), near);
       const double texels = per_unit / z;  // per object unit, at most
       const double cosine = std::min(1.0, std::abs(side) / std::max(glm::length(eye - centre), 1e-30));
-      chosen_[chosen] = std::uint32_t(p);
+      list[chosen] = std::uint32_t(p);
       chosen += std::size_t((any_side | (side > 0.0)) & !(double(mesh.inradius[p]) * texels < half_side) &
                             !(double(b.area) * cosine * texels * texels < circle));
     }
   }
-  std::uint32_t drawn = 0;
-  if (mesh.shared_corners) begin_vertices(positions.size());
-  for (std::size_t i = 0; i < chosen; ++i)
-    raster_mesh_polygon(positions, mesh, chosen_[i], object_to_clip, drawn);
+  return chosen;
+}
+
+std::uint32_t OcclusionBuffer::raster_polygons(std::span<const glm::vec3> positions, const OccluderMesh& mesh,
+                                               const std::uint32_t* list, std::size_t count,
+                                               const glm::dmat4& object_to_clip) {
+  const auto polygon = [&](std::size_t i) { return list ? list[i] : i; };
+  lanes_[0].keys = keys_.data(), lanes_[0].dirty = tile_dirty_.data();
+  const std::size_t lanes = count >= parallel_polygons ? lanes_.size() : 1;
+  for (std::size_t l = 0; l < lanes; ++l) {
+    Lane& lane = lanes_[l];
+    if (l > 0) lane.keys = lane.own_keys.data(), lane.dirty = lane.own_dirty.data();
+    lane.count = 0;
+    if (mesh.shared_corners) begin_vertices(lane, positions.size());
+  }
+  if (lanes == 1) {
+    for (std::size_t i = 0; i < count; ++i) raster_mesh_polygon(lanes_[0], positions, mesh, polygon(i), object_to_clip);
+    return lanes_[0].count;
+  }
+  // Runs of a few polygons, taken in turn by whichever thread is free (a
+  // thread woken late takes fewer): which thread rasterizes a polygon
+  // changes no texel once merged.
+  constexpr std::size_t kRun = 16;
+  const std::size_t runs = (count + kRun - 1) / kRun;
+  std::atomic<std::size_t> next{0};
+  auto job = [&](int l) {
+    Lane& lane = lanes_[std::size_t(l)];
+    for (std::size_t r = next.fetch_add(1, std::memory_order_relaxed); r < runs;
+         r = next.fetch_add(1, std::memory_order_relaxed))
+      for (std::size_t i = r * kRun, end = std::min(count, i + kRun); i < end; ++i)
+        raster_mesh_polygon(lane, positions, mesh, polygon(i), object_to_clip);
+  };
+  pool_->run(job);
+  std::uint32_t drawn = lanes_[0].count;
+  for (std::size_t l = 1; l < lanes; ++l) {
+    merge(lanes_[l]);
+    drawn += lanes_[l].count;
+  }
   return drawn;
 }
 
-void OcclusionBuffer::begin_vertices(std::size_t vertices) {
-  if (vertex_stamp_.size() < vertices) {
-    vertex_stamp_.resize(vertices, 0);
-    vertices_.resize(vertices);
+void OcclusionBuffer::begin_vertices(Lane& lane, std::size_t vertices) {
+  if (lane.vertex_stamp.size() < vertices) {
+    lane.vertex_stamp.resize(vertices, 0);
+    lane.vertices.resize(vertices);
   }
-  if (++stamp_ == 0) {  // wrapped: no stamp may look current
-    std::fill(vertex_stamp_.begin(), vertex_stamp_.end(), 0u);
-    stamp_ = 1;
+  if (++lane.stamp == 0) {  // wrapped: no stamp may look current
+    std::fill(lane.vertex_stamp.begin(), lane.vertex_stamp.end(), 0u);
+    lane.stamp = 1;
   }
 }
 
-void OcclusionBuffer::mesh_corners(std::span<const glm::vec3> positions, const OccluderMesh& mesh, std::size_t p,
-                                   const glm::dmat4& object_to_clip, ClipVertex* local, ClipVertex** v) {
+void OcclusionBuffer::mesh_corners(Lane& lane, std::span<const glm::vec3> positions, const OccluderMesh& mesh,
+                                   std::size_t p, const glm::dmat4& object_to_clip, ClipVertex* local,
+                                   ClipVertex** v) const {
   const std::uint32_t* corners = mesh.corners.data() + 4 * p;
   const int n = corners[3] == OccluderMesh::no_corner ? 3 : 4;
   for (int k = 0; k < n; ++k) {
@@ -431,23 +548,22 @@ void OcclusionBuffer::mesh_corners(std::span<const glm::vec3> positions, const O
       v[k] = &local[k];
       continue;
     }
-    if (vertex_stamp_[i] != stamp_) {
-      vertices_[i] = classify(object_to_clip * glm::dvec4(glm::dvec3(positions[i]), 1.0));
-      vertex_stamp_[i] = stamp_;
+    if (lane.vertex_stamp[i] != lane.stamp) {
+      lane.vertices[i] = classify(object_to_clip * glm::dvec4(glm::dvec3(positions[i]), 1.0));
+      lane.vertex_stamp[i] = lane.stamp;
     }
-    v[k] = &vertices_[i];
+    v[k] = &lane.vertices[i];
   }
 }
 
-void OcclusionBuffer::raster_mesh_polygon(std::span<const glm::vec3> positions, const OccluderMesh& mesh,
-                                          std::size_t p, const glm::dmat4& object_to_clip,
-                                          std::uint32_t& count) {
+void OcclusionBuffer::raster_mesh_polygon(Lane& lane, std::span<const glm::vec3> positions, const OccluderMesh& mesh,
+                                          std::size_t p, const glm::dmat4& object_to_clip) const {
   const int n = mesh.corners[4 * p + 3] == OccluderMesh::no_corner ? 3 : 4;
   ClipVertex local[4];
   ClipVertex* v[4];
-  mesh_corners(positions, mesh, p, object_to_clip, local, v);
+  mesh_corners(lane, positions, mesh, p, object_to_clip, local, v);
   // Rule 11 (which rests on rules 2-4: none of them switched off).
-  if (!raster_clipped(v, n, count) || !fused_pairs_ || mesh.neighbours.empty() || !rules_.inner_coverage ||
+  if (!raster_clipped(lane, v, n) || !fused_pairs_ || mesh.neighbours.empty() || !rules_.inner_coverage ||
       !rules_.farthest_depth || !drawn_whole(v, n))
     return;
   // Each edge this polygon shares with an earlier polygon of the mesh (one
@@ -471,7 +587,7 @@ void OcclusionBuffer::raster_mesh_polygon(std::span<const glm::vec3> positions, 
     // the edge as this polygon runs it, nor as the other runs it back.
     const std::int64_t X[2] = {a.x, b.x}, Y[2] = {a.y, b.y};
     const Edge band[2] = {not_wholly_inside(make_edge(X, Y, 0, 1)), not_wholly_inside(make_edge(X, Y, 1, 0))};
-    if (might_cover(band, 2, r)) fuse_edge(positions, mesh, v, n, k, q, r, band, object_to_clip);
+    if (might_cover(band, 2, r)) fuse_edge(lane, positions, mesh, v, n, k, q, r, band, object_to_clip);
   }
 }
 
@@ -508,9 +624,9 @@ bool OcclusionBuffer::might_cover(const Edge* edges, int count, const TexelRect&
 
 // Rule 11: the band along the edge k of polygon A (corners v) that it shares
 // with polygon q (B).
-void OcclusionBuffer::fuse_edge(std::span<const glm::vec3> positions, const OccluderMesh& mesh, ClipVertex* const* v,
-                                int n, int k, std::uint32_t q, const TexelRect& r, const Edge* band,
-                                const glm::dmat4& object_to_clip) {
+void OcclusionBuffer::fuse_edge(Lane& lane, std::span<const glm::vec3> positions, const OccluderMesh& mesh,
+                                ClipVertex* const* v, int n, int k, std::uint32_t q, const TexelRect& r,
+                                const Edge* band, const glm::dmat4& object_to_clip) const {
   const int k1 = (k + 1) % n;
   std::int64_t XA[4], YA[4];
   for (int i = 0; i < n; ++i) XA[i] = v[i]->x, YA[i] = v[i]->y;
@@ -528,7 +644,7 @@ void OcclusionBuffer::fuse_edge(std::span<const glm::vec3> positions, const Occl
   const int m = mesh.corners[4 * std::size_t(q) + 3] == OccluderMesh::no_corner ? 3 : 4;
   ClipVertex local[4];
   ClipVertex* w[4];
-  mesh_corners(positions, mesh, q, object_to_clip, local, w);
+  mesh_corners(lane, positions, mesh, q, object_to_clip, local, w);
   if (!drawn_whole(w, m)) return;
   std::int64_t XB[4], YB[4];
   glm::dvec3 sA[4], sB[4];
@@ -560,7 +676,7 @@ void OcclusionBuffer::fuse_edge(std::span<const glm::vec3> positions, const Occl
                   (plane.off_plane + other.off_plane) * (2.0 + 6.0 / length);
     plane.cap = std::max(plane.cap, other.cap);
   }
-  fill_region(edges, count, r, plane);
+  fill_region(lane, edges, count, r, plane);
 }
 
 namespace {
@@ -604,7 +720,7 @@ void OcclusionBuffer::project_once(ClipVertex& v) const {
 // Rule 1: clips a convex polygon at the near plane and the guard band (in
 // double, Sutherland-Hodgman), then rasterizes what is left. True when the
 // polygon needed no clipping and faces the eye (its corners projected).
-bool OcclusionBuffer::raster_clipped(ClipVertex* const* v, int vertices, std::uint32_t& count) {
+bool OcclusionBuffer::raster_clipped(Lane& lane, ClipVertex* const* v, int vertices) const {
   const double guard = guard_band(width_, height_);
   const double near_depth = clip_.near_depth();
   const auto distance = [&](const glm::dvec4& c, int plane) -> double {
@@ -647,10 +763,10 @@ bool OcclusionBuffer::raster_clipped(ClipVertex* const* v, int vertices, std::ui
       for (int i = 0; i < vertices; ++i)
         area += s[i].x * s[(i + 1) % vertices].y - s[(i + 1) % vertices].x * s[i].y;
       if (!(area > 0.0)) return false;  // rule 2: front faces only
-      raster_snapped(s, X, Y, vertices, count);
+      raster_snapped(lane, s, X, Y, vertices);
       return true;
     }
-    raster_polygon(s, vertices, count);
+    raster_polygon(lane, s, vertices);
     return false;
   }
   glm::dvec4 poly[kMax], next[kMax];
@@ -676,11 +792,11 @@ bool OcclusionBuffer::raster_clipped(ClipVertex* const* v, int vertices, std::ui
     std::copy(next, next + n, poly);
   }
   for (int i = 0; i < n; ++i) s[i] = project(poly[i]);
-  raster_polygon(s, n, count);
+  raster_polygon(lane, s, n);
   return false;
 }
 
-void OcclusionBuffer::raster_polygon(const glm::dvec3* in, int n, std::uint32_t& count) {
+void OcclusionBuffer::raster_polygon(Lane& lane, const glm::dvec3* in, int n) const {
   constexpr int kMax = 9;
   assert(n >= 3 && n <= kMax);
   // Rule 2: front faces only (counter-clockwise with y up).
@@ -699,7 +815,7 @@ void OcclusionBuffer::raster_polygon(const glm::dvec3* in, int n, std::uint32_t&
     X[k] = snap(v[k].x);
     Y[k] = snap(v[k].y);
   }
-  raster_snapped(v, X, Y, n, count);
+  raster_snapped(lane, v, X, Y, n);
 }
 
 OcclusionBuffer::Edge OcclusionBuffer::make_edge(const std::int64_t* X, const std::int64_t* Y, int i, int j) const {
@@ -762,8 +878,8 @@ OcclusionBuffer::Edge OcclusionBuffer::make_edge(const std::int64_t* X, const st
 }
 
 // A front-facing convex polygon, counter-clockwise, its corners snapped to X, Y.
-void OcclusionBuffer::raster_snapped(const glm::dvec3* v, const std::int64_t* X, const std::int64_t* Y, int n,
-                                     std::uint32_t& count) {
+void OcclusionBuffer::raster_snapped(Lane& lane, const glm::dvec3* v, const std::int64_t* X, const std::int64_t* Y,
+                                     int n) const {
   std::int64_t snapped_area = 0;
   for (int k = 0; k < n; ++k) snapped_area += X[k] * Y[(k + 1) % n] - X[(k + 1) % n] * Y[k];
   if (snapped_area <= 0) return;  // degenerate once snapped
@@ -773,7 +889,7 @@ void OcclusionBuffer::raster_snapped(const glm::dvec3* v, const std::int64_t* X,
   // either axis covers none (a shortcut: the edge functions would find none).
   const std::int64_t reach = rules_.inner_coverage ? kSub - 2 * inset_ + 2 * kGrow : 0;
   if (max_x - min_x < reach || max_y - min_y < reach) return;
-  ++count;
+  ++lane.count;
   // The texels whose grown square (rule 10: their centres' square) fits in
   // the polygon's bounding rectangle: no other can lie inside every edge
   // (what lies inside every edge of a polygon lies inside the polygon). A
@@ -793,13 +909,13 @@ void OcclusionBuffer::raster_snapped(const glm::dvec3* v, const std::int64_t* X,
   const int edge_count = polygon_edges(X, Y, n, edges);
   DepthPlane plane;
   if (!depth_plane(v, n, plane)) return;
-  fill_region(edges, edge_count, {x_lo, x_hi, y_lo, y_hi}, plane);
+  fill_region(lane, edges, edge_count, {x_lo, x_hi, y_lo, y_hi}, plane);
 }
 
 // Writes the depth bound into every texel of r
 // inside every edge.
-[[gnu::always_inline]] inline void OcclusionBuffer::fill_region(const Edge* edges, int edge_count, const TexelRect& r,
-                                                                 const DepthPlane& plane) {
+[[gnu::always_inline]] inline void OcclusionBuffer::fill_region(Lane& lane, const Edge* edges, int edge_count,
+                                                                 const TexelRect& r, const DepthPlane& plane) const {
   const int x_lo = r.x_lo, x_hi = r.x_hi, y_lo = r.y_lo, y_hi = r.y_hi;
   const bool strict = rules_.inner_coverage;
   const float step = float(plane.gx);
@@ -863,13 +979,13 @@ void OcclusionBuffer::raster_snapped(const glm::dvec3* v, const std::int64_t* X,
                           plane.gy * (double(ty) + plane.fy - plane.p0.y) + plane.bias;
     float base = float(base_d);
     if (double(base) < base_d) base = next_up(base);
-    float* row = keys_.data() + std::size_t(ty) * std::size_t(width_) + std::size_t(lo);
+    float* row = lane.keys + std::size_t(ty) * std::size_t(width_) + std::size_t(lo);
     const int span = int(hi - lo + 1);
     if (simd_ == SimdPath::best)
       simd::fill_span(row, span, base, step, plane.cap);
     else
       fill_span_scalar(row, span, base, step, plane.cap);
-    std::uint8_t* dirty = tile_dirty_.data() + std::size_t(ty / tile_size) * std::size_t(tiles_x_);
+    std::uint8_t* dirty = lane.dirty + std::size_t(ty / tile_size) * std::size_t(tiles_x_);
     for (int t = int(lo) / tile_size; t <= int(hi) / tile_size; ++t) dirty[t] = 1;
   }
 }

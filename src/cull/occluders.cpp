@@ -16,23 +16,39 @@ void Occluders::begin_frame(const View& view, const OcclusionBuffer& buffer) {
   sometimes_left_ = std::uint64_t(choice_.budget);
 }
 
-void Occluders::rasterize_if_occluder(OcclusionBuffer& buffer, ObjectId id, const Aabb& bounds, const View& view,
-                                      BufferCounters& counters) {
+std::optional<OcclusionBuffer::OccluderDraw> Occluders::occluder_draw(ObjectId id, const Aabb& bounds,
+                                                                       const View& view) {
   // How many texels across the box's bounding sphere spans: a smaller
   // occluder covers next to no texel whole (rule 3), and costs its polygons.
   const double radius = 0.5 * double(glm::length(bounds.extent()));
   const double distance = view.orthographic ? 1.0 : std::max(double(glm::length(bounds.center() - view.eye)), 1e-6);
-  if (2.0 * radius * texel_scale_ / distance < choice_.min_texels) return;
+  if (2.0 * radius * texel_scale_ / distance < choice_.min_texels) return std::nullopt;
   const Object& o = scene_.object(id);
-  if (o.removed || o.occluder == OccluderClass::never || scene_.material(o.material).translucent) return;
+  if (o.removed || o.occluder == OccluderClass::never || scene_.material(o.material).translucent) return std::nullopt;
   const Mesh& mesh = scene_.mesh(o.mesh);
-  if (mesh.positions.empty()) return;  // the engine keeps its vertices: nothing to rasterize
-  if (o.occluder == OccluderClass::sometimes && o.triangles > sometimes_left_) return;
+  if (mesh.positions.empty()) return std::nullopt;  // the engine keeps its vertices: nothing to rasterize
+  if (o.occluder == OccluderClass::sometimes) {
+    if (o.triangles > sometimes_left_) return std::nullopt;
+    sometimes_left_ -= o.triangles;
+  }
+  return OcclusionBuffer::OccluderDraw{mesh.positions, &occluder_of(o.mesh), o.transform, o.bounds};
+}
+
+bool Occluders::rasterize_if_occluder(OcclusionBuffer& buffer, ObjectId id, const Aabb& bounds, const View& view,
+                                      BufferCounters& counters) {
+  const std::optional<OcclusionBuffer::OccluderDraw> draw = occluder_draw(id, bounds, view);
+  if (!draw) return false;
   const auto start = std::chrono::steady_clock::now();
-  const std::uint32_t drawn = buffer.rasterize(mesh.positions, occluder_of(o.mesh), view, o.transform, o.bounds);
+  counters.occluder_triangles += buffer.rasterize(draw->positions, *draw->mesh, view, draw->object_to_world, draw->bounds);
   counters.raster_ms += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-  counters.occluder_triangles += drawn;
-  if (o.occluder == OccluderClass::sometimes) sometimes_left_ -= o.triangles;
+  return true;
+}
+
+void Occluders::rasterize(OcclusionBuffer& buffer, std::span<const OcclusionBuffer::OccluderDraw> draws,
+                          const View& view, BufferCounters& counters) {
+  const auto start = std::chrono::steady_clock::now();
+  counters.occluder_triangles += buffer.rasterize(draws, view);
+  counters.raster_ms += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
 }
 
 bool test_box(OcclusionBuffer& buffer, const Aabb& box, const glm::mat4& view_proj, BufferCounters& counters) {

@@ -59,7 +59,30 @@ class SocCuller final : public Culler {
     }
     if (++frame_ == 0) {  // wrapped: no node may look shown last frame
       std::fill(shown_.begin(), shown_.end(), 0u);
+      std::fill(prerasterized_.begin(), prerasterized_.end(), 0u);
       frame_ = 2;
+    }
+
+    // The prepass: last frame's occluders still in the frustum, rasterized
+    // first in one batch (on the buffer's threads) and drawn this frame
+    // whatever the walk finds.
+    const std::size_t objects = index_.scene.objects().size();
+    if (prerasterized_.size() != objects) prerasterized_.assign(objects, 0);
+    std::swap(last_occluders_, occluders_drawn_);
+    occluders_drawn_.clear();
+    if (config_.prepass) {
+      draws_.clear();
+      for (const ObjectId id : last_occluders_) {
+        if (id >= objects) continue;
+        const Object& o = index_.scene.object(id);
+        if (o.removed || view.frustum.classify(o.bounds) == Containment::outside) continue;
+        const std::optional<OcclusionBuffer::OccluderDraw> draw = occluders_.occluder_draw(id, o.bounds, view);
+        if (!draw) continue;
+        draws_.push_back(*draw);
+        prerasterized_[id] = frame_;
+        queue_.push_back(id);
+      }
+      occluders_.rasterize(buffer, draws_, view, counters);
     }
 
     DistanceQueue open;
@@ -83,8 +106,14 @@ class SocCuller final : public Culler {
       for (ObjectId id : leaf_) {
         const Aabb& box = tested ? bvh.node(n).bounds : index_.scene.object(id).bounds;
         if (!tested && test_box(buffer, box, view.view_proj, counters)) continue;
-        queue_.push_back(id);
-        occluders_.rasterize_if_occluder(buffer, id, box, view, counters);
+        if (prerasterized_[id] == frame_) {
+          // Queued and rasterized by the prepass (its own polygons cannot hide its box: they lie inside it);
+          // in the next prepass only if found visible again.
+          occluders_drawn_.push_back(id);
+        } else {
+          queue_.push_back(id);
+          if (occluders_.rasterize_if_occluder(buffer, id, box, view, counters)) occluders_drawn_.push_back(id);
+        }
         for (NodeId m = n; m != kNoNode && shown_[m] != frame_; m = bvh.node(m).parent) shown_[m] = frame_;
       }
     }
@@ -100,6 +129,7 @@ class SocCuller final : public Culler {
     const SimdPath simd = config_.simd ? SimdPath::best : SimdPath::scalar;
     if (!buffer_ || buffer_->width() != w || buffer_->height() != h) buffer_.emplace(w, h, simd);
     buffer_->set_fused_pairs(config_.fuse);
+    buffer_->set_threads(config_.threads);
     return *buffer_;
   }
 
@@ -110,6 +140,9 @@ class SocCuller final : public Culler {
   std::optional<OcclusionBuffer> buffer_;
   FrustumCache frustum_;
   std::vector<ObjectId> queue_, leaf_;
+  std::vector<ObjectId> occluders_drawn_, last_occluders_;  // occluders rasterized this frame, and last
+  std::vector<std::uint32_t> prerasterized_;  // per object: the last frame_ the prepass rasterized it
+  std::vector<OcclusionBuffer::OccluderDraw> draws_;  // the prepass's (scratch)
   std::vector<std::uint32_t> shown_;  // per node: the last frame_ it held a drawn object (0: none)
   std::uint32_t frame_ = 1;
   std::uint64_t generation_ = 0;      // of the hierarchy shown_ follows
@@ -130,6 +163,12 @@ Registration soc_registration() {
           .real("detail", [](auto& c) -> auto& { return c.occluders.detail; }, 0.0, 1e6,
                 "an occluder's polygons whose inscribed circle is below 1/detail of its largest are not rasterized "
                 "(0: all)")
+          .integer("threads", &SocConfig::threads, 1, OcclusionBuffer::max_threads,
+                   "threads rasterizing an occluder of many polygons (the caller's and the buffer's own; the buffer "
+                   "is the same whatever the threads)")
+          .flag("prepass", &SocConfig::prepass,
+                "last frame's occluders still in the frustum rasterized first, in one batch shared among the "
+                "threads, and drawn whatever the walk finds")
           .flag("simd", &SocConfig::simd, "vectorised inner loops (off: the scalar reference, equal bit for bit)")
           .flag("fuse", &SocConfig::fuse,
                 "polygons of an occluder that share an edge cover the seam between them (the buffer's rule 11; off: "
