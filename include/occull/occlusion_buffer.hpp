@@ -360,6 +360,10 @@ class OcclusionBuffer {
   /// on every lane when there are enough of them. Returns how many were rasterized.
   std::uint32_t raster_polygons(std::span<const glm::vec3> positions, const OccluderMesh& mesh,
                                 const std::uint32_t* list, std::size_t count, const glm::dmat4& object_to_clip);
+  /// Points the first `lanes` lanes at their keys (lane 0 at the buffer's), none rasterized yet.
+  void start_lanes(std::size_t lanes);
+  /// Merges lanes 1..lanes-1 into the buffer; returns the polygons all rasterized.
+  std::uint32_t finish_lanes(std::size_t lanes);
   /// Merges lane's keys into the buffer's (the nearest kept), and empties them.
   void merge(Lane& lane);
   /// Sets v's window, x and y if not yet. Precondition: !v.crossing_near.

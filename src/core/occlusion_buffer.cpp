@@ -366,8 +366,8 @@ std::size_t OcclusionBuffer::covered_texels() const noexcept {
 
 std::uint32_t OcclusionBuffer::rasterize(std::span<const glm::vec3> positions, std::span<const std::uint32_t> indices,
                                          const glm::dmat4& object_to_clip) {
+  start_lanes(1);
   Lane& lane = lanes_[0];
-  lane.keys = keys_.data(), lane.dirty = tile_dirty_.data(), lane.count = 0;
   for (std::size_t i = 0; i + 2 < indices.size(); i += 3) {
     ClipVertex c[3];
     for (int k = 0; k < 3; ++k) {
@@ -399,10 +399,7 @@ std::uint32_t OcclusionBuffer::rasterize(std::span<const glm::vec3> positions, c
 }
 
 std::uint32_t OcclusionBuffer::rasterize(std::span<const OccluderDraw> draws, const View& view) {
-  lanes_[0].keys = keys_.data(), lanes_[0].dirty = tile_dirty_.data();
-  for (std::size_t l = 1; l < lanes_.size(); ++l)
-    lanes_[l].keys = lanes_[l].own_keys.data(), lanes_[l].dirty = lanes_[l].own_dirty.data();
-  for (Lane& lane : lanes_) lane.count = 0;
+  start_lanes(lanes_.size());
   // Each draw whole on one thread, taken in turn by whichever is free.
   std::atomic<std::size_t> next{0};
   auto job = [&](int l) {
@@ -422,12 +419,7 @@ std::uint32_t OcclusionBuffer::rasterize(std::span<const OccluderDraw> draws, co
     pool_->run(job);
   else
     job(0);
-  std::uint32_t drawn = lanes_[0].count;
-  for (std::size_t l = 1; l < lanes_.size(); ++l) {
-    merge(lanes_[l]);
-    drawn += lanes_[l].count;
-  }
-  return drawn;
+  return finish_lanes(lanes_.size());
 }
 
 std::size_t OcclusionBuffer::choose_polygons(std::vector<std::uint32_t>& list, const OccluderMesh& mesh,
@@ -491,14 +483,9 @@ std::uint32_t OcclusionBuffer::raster_polygons(std::span<const glm::vec3> positi
                                                const std::uint32_t* list, std::size_t count,
                                                const glm::dmat4& object_to_clip) {
   const auto polygon = [&](std::size_t i) { return list ? list[i] : i; };
-  lanes_[0].keys = keys_.data(), lanes_[0].dirty = tile_dirty_.data();
   const std::size_t lanes = count >= parallel_polygons ? lanes_.size() : 1;
-  for (std::size_t l = 0; l < lanes; ++l) {
-    Lane& lane = lanes_[l];
-    if (l > 0) lane.keys = lane.own_keys.data(), lane.dirty = lane.own_dirty.data();
-    lane.count = 0;
-    if (mesh.shared_corners) begin_vertices(lane, positions.size());
-  }
+  start_lanes(lanes);
+  for (std::size_t l = 0; l < lanes && mesh.shared_corners; ++l) begin_vertices(lanes_[l], positions.size());
   if (lanes == 1) {
     for (std::size_t i = 0; i < count; ++i) raster_mesh_polygon(lanes_[0], positions, mesh, polygon(i), object_to_clip);
     return lanes_[0].count;
@@ -517,6 +504,19 @@ std::uint32_t OcclusionBuffer::raster_polygons(std::span<const glm::vec3> positi
         raster_mesh_polygon(lane, positions, mesh, polygon(i), object_to_clip);
   };
   pool_->run(job);
+  return finish_lanes(lanes);
+}
+
+void OcclusionBuffer::start_lanes(std::size_t lanes) {
+  for (std::size_t l = 0; l < lanes; ++l) {
+    Lane& lane = lanes_[l];
+    lane.keys = l == 0 ? keys_.data() : lane.own_keys.data();
+    lane.dirty = l == 0 ? tile_dirty_.data() : lane.own_dirty.data();
+    lane.count = 0;
+  }
+}
+
+std::uint32_t OcclusionBuffer::finish_lanes(std::size_t lanes) {
   std::uint32_t drawn = lanes_[0].count;
   for (std::size_t l = 1; l < lanes; ++l) {
     merge(lanes_[l]);
