@@ -192,6 +192,51 @@ TEST(Soc, AnInteriorNodeShownLastFrameIsNotTestedAgainButItsObjectsAre) {
   EXPECT_EQ(third, expected);
 }
 
+// 144 boxes of varied heights in 12 rows down -Z: rows hide rows.
+std::vector<Aabb> rows_of_boxes() {
+  std::vector<Aabb> boxes;
+  for (int i = 0; i < 12; ++i)
+    for (int j = 0; j < 12; ++j) {
+      const float x = -30.0f + 5.0f * float(i), z = -8.0f - 5.0f * float(j), h = float((i * 7 + j * 3) % 5);
+      boxes.push_back({{x, -2.0f, z}, {x + 3.0f, h, z + 1.0f}});
+    }
+  return boxes;
+}
+
+// The camera of frame `frame`, moving sideways.
+View moving_camera(int frame) {
+  CameraPose pose;
+  pose.position = glm::vec3(0.5f * float(frame), 0.0f, 0.0f);
+  return make_view(pose, Lens{60.0f, 0.1f, 100.0f}, 320, 180);
+}
+
+// The query cullers' CPU test on threads (cpu_threads) rasterizes each batch
+// drawn among them: chcpp asks the device the same queries and draws the
+// same as with one thread, and fewer than without the test (the CPU answered
+// some). The scene and device of ChcppWithTheFirstTestIssuesFewerQueriesAndDrawsTheSame.
+TEST(CpuTestBackend, ThreadsAnswerAsOneThreadDoes) {
+  std::vector<Aabb> boxes = {{{-40, -40, -11}, {40, 40, -10}}};
+  for (int i = 0; i < 40; ++i) boxes.push_back({{-20.0f + float(i), -1, -30}, {-19.5f + float(i), 1, -28}});
+  const Scene scene = test::box_scene(boxes);
+  const Bvh bvh = Bvh::build(scene);
+  std::map<std::string, std::pair<std::vector<ObjectId>, std::size_t>> runs;  // drawn, device queries
+  for (const std::string spec : {"chcpp:virtual_leaf=0", "chcpp:virtual_leaf=0:cpu_test=on",
+                                 "chcpp:virtual_leaf=0:cpu_test=on:cpu_threads=3"}) {
+    ScriptedBackend device;
+    device.visible_samples = [&](std::span<const Aabb> b) {
+      std::uint64_t n = 0;
+      for (const Aabb& box : b) n += box.max.z > -12.0f ? 1 : 0;
+      return n;
+    };
+    auto culler = make_culler(spec, {scene, bvh});
+    for (int frame = 0; frame < 6; ++frame) (void)culler->render_frame(camera(), device);
+    std::sort(device.rendered.begin(), device.rendered.end());
+    runs[spec] = {device.rendered, device.queried.size()};
+  }
+  EXPECT_EQ(runs["chcpp:virtual_leaf=0:cpu_test=on:cpu_threads=3"], runs["chcpp:virtual_leaf=0:cpu_test=on"]);
+  EXPECT_LT(runs["chcpp:virtual_leaf=0:cpu_test=on"].second, runs["chcpp:virtual_leaf=0"].second);
+}
+
 // soc:prepass=on rasterizes last frame's occluders before its walk, so it
 // must draw them whatever the walk finds (a rasterized occluder that is not
 // drawn could hide what lies behind it on screen), and carries into the next
@@ -230,12 +275,7 @@ TEST(Soc, ThePrepassDrawsLastFramesOccludersAndCarriesOnlyThoseFoundVisible) {
 // soc's threads (soc:threads, the buffer's own) share its prepass and its
 // occluders of many polygons: it draws what one thread draws, frame by frame.
 TEST(Soc, ThreadsDrawWhatOneThreadDraws) {
-  std::vector<Aabb> boxes;
-  for (int i = 0; i < 12; ++i)
-    for (int j = 0; j < 12; ++j) {
-      const float x = -30.0f + 5.0f * float(i), z = -8.0f - 5.0f * float(j), h = float((i * 7 + j * 3) % 5);
-      boxes.push_back({{x, -2.0f, z}, {x + 3.0f, h, z + 1.0f}});
-    }
+  const std::vector<Aabb> boxes = rows_of_boxes();
   const Scene scene = test::box_scene(boxes);
   const Bvh bvh = Bvh::build(scene);
   for (const char* scale : {"", ":scale=1"}) {
@@ -245,10 +285,8 @@ TEST(Soc, ThreadsDrawWhatOneThreadDraws) {
       auto soc = make_culler(spec, {scene, bvh});
       ScriptedBackend device;
       for (int frame = 0; frame < 6; ++frame) {
-        CameraPose pose;
-        pose.position = glm::vec3(0.5f * float(frame), 0.0f, 0.0f);
         device.rendered.clear();
-        (void)soc->render_frame(make_view(pose, Lens{60.0f, 0.1f, 100.0f}, 320, 180), device);
+        (void)soc->render_frame(moving_camera(frame), device);
         std::sort(device.rendered.begin(), device.rendered.end());
         frames[spec].push_back(device.rendered);
       }

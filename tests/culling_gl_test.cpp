@@ -31,7 +31,8 @@ const char* const kConservative[] = {
     "hiz", "hiz:texels=2", "hiz:texels=16",
     "soc", "soc:scale=1", "soc:width=64:height=36", "soc:width=131:height=47", "soc:simd=off",
     "soc:prepass=on:threads=2", "soc:scale=1:prepass=on:threads=3",
-    "chc:cpu_test=on", "chcpp:cpu_test=on", "chcpp:cpu_test=on:cpu_scale=1", "nohc:cpu_test=on"};
+    "chc:cpu_test=on", "chcpp:cpu_test=on", "chcpp:cpu_test=on:cpu_scale=1", "nohc:cpu_test=on",
+    "chcpp:cpu_test=on:cpu_scale=1:cpu_threads=2"};
 
 gl::RendererOptions small_target() { return test::small_target(192, 108); }
 

@@ -37,6 +37,9 @@ struct QueryOptions {
   /// 1 at a single-sampled view covers pixel centres (the buffer's rule 10):
   /// more hidden, more CPU.
   int cpu_scale = 4;
+  /// Threads rasterizing the CPU test's occluders, each batch drawn shared
+  /// among them; in [1, 64]. The buffer is the same whatever the threads.
+  int cpu_threads = 1;
 };
 
 /// The boxes a node's query draws.

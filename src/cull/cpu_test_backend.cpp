@@ -2,6 +2,7 @@
 
 #include "occluders.hpp"
 #include "occull/error.hpp"
+#include "core/format.hpp"
 
 #include <algorithm>
 #include <optional>
@@ -48,12 +49,17 @@ struct CpuTestBackend::Impl {
   detail::BufferCounters counters;
   std::uint64_t answered = 0;
   std::vector<Slot> slots;
+  std::vector<OcclusionBuffer::OccluderDraw> draws;  // render()'s occluders (scratch)
   std::vector<QueryId> free;
   std::vector<ObjectId> translucent;
 };
 
 CpuTestBackend::CpuTestBackend(const Scene& scene, const Options& options)
-    : impl_(std::make_unique<Impl>(scene, options)) {}
+    : impl_(std::make_unique<Impl>(scene, options)) {
+  if (options.threads < 1 || options.threads > OcclusionBuffer::max_threads)
+    throw UsageError(detail::format("CpuTestBackend: {} threads (in [1, {}])", options.threads,
+                                    OcclusionBuffer::max_threads));
+}
 CpuTestBackend::~CpuTestBackend() = default;
 
 void CpuTestBackend::begin_frame(Backend& inner, const View& view) {
@@ -62,7 +68,10 @@ void CpuTestBackend::begin_frame(Backend& inner, const View& view) {
   m.view = &view;
   const int scale = std::max(1, m.options.scale);
   const int w = std::max(1, view.width / scale), h = std::max(1, view.height / scale);
-  if (!m.buffer || m.buffer->width() != w || m.buffer->height() != h) m.buffer.emplace(w, h, m.options.simd);
+  if (!m.buffer || m.buffer->width() != w || m.buffer->height() != h) {
+    m.buffer.emplace(w, h, m.options.simd);
+    m.buffer->set_threads(m.options.threads);
+  }
   m.buffer->clear(view);
   m.occluders.begin_frame(view, *m.buffer);
   m.counters = {};
@@ -83,8 +92,12 @@ std::uint64_t CpuTestBackend::answered() const noexcept { return impl_->answered
 void CpuTestBackend::render(std::span<const ObjectId> objects) {
   Impl& m = *impl_;
   m.inner_backend().render(objects);
-  // Drawn: each occluder among them now hides what lies behind it.
-  for (ObjectId id : objects) m.occluders.rasterize_if_occluder(*m.buffer, id, *m.view, m.counters);
+  // Drawn: each occluder among them now hides what lies behind it, rasterized
+  // as one batch (shared among the buffer's threads).
+  m.draws.clear();
+  for (ObjectId id : objects)
+    if (auto draw = m.occluders.occluder_draw(id, m.scene.object(id).bounds, *m.view)) m.draws.push_back(*draw);
+  if (!m.draws.empty()) m.occluders.rasterize(*m.buffer, m.draws, *m.view, m.counters);
 }
 
 QueryId CpuTestBackend::issue_query(std::span<const Aabb> boxes) {

@@ -326,7 +326,7 @@ class CpuTestedCuller : public Culler, public Resumable {
  public:
   CpuTestedCuller(const SceneIndex& index, const QueryOptions& options)
       : cpu_test_(options.cpu_test
-                      ? std::make_unique<CpuTestBackend>(index.scene, CpuTestBackend::Options{.scale = options.cpu_scale})
+                      ? std::make_unique<CpuTestBackend>(index.scene, CpuTestBackend::Options{.scale = options.cpu_scale, .threads = options.cpu_threads})
                       : nullptr) {}
 
   FrameResult cull(const View& view, Backend& backend) final {
@@ -388,7 +388,10 @@ ConfigTable<Config>&& with_common_options(ConfigTable<Config>&& table, At at) {
             "ask a conservative CPU occlusion buffer of the occluders drawn so far before each query; issue it only "
             "when the buffer cannot prove the boxes hidden (CpuTestBackend)")
       .integer("cpu_scale", [at](auto& c) -> auto& { return std::invoke(at, c).cpu_scale; }, 1, 64,
-               "the CPU test's buffer = viewport / cpu_scale on each axis");
+               "the CPU test's buffer = viewport / cpu_scale on each axis")
+      .integer("cpu_threads", [at](auto& c) -> auto& { return std::invoke(at, c).cpu_threads; }, 1,
+               OcclusionBuffer::max_threads,
+               "threads rasterizing the CPU test's occluders (each batch drawn shared among them)");
 }
 
 }  // namespace occull::detail
