@@ -296,6 +296,35 @@ TEST(Soc, ThreadsDrawWhatOneThreadDraws) {
   }
 }
 
+// A prepassed occluder that the prepass's other occluders hide is not drawn:
+// its own texels lie no nearer than its box, behind what hides the box, so
+// rasterizing it changed no texel. The back wall is half hidden (drawn,
+// carried), then the front wall moves over all of it: with both in the
+// prepass, the back wall is found hidden there and not drawn.
+TEST(Soc, APrepassedOccluderFoundHiddenAfterThePrepassIsNotDrawn) {
+  Scene scene = test::box_scene({{{-40, -40, -11}, {40, 40, -10}},   // 0: the front wall, half over the back one at first
+                                 {{-20, -20, -31}, {20, 20, -30}}});  // 1: the back wall
+  Bvh bvh = Bvh::build(scene);
+  scene.set_transform(0, glm::translate(glm::mat4(1.0f), glm::vec3(40.0f, 0.0f, 0.0f)));
+  bvh.refit(scene);
+  scene.clear_moved();
+  auto soc = make_culler("soc:prepass=on", {scene, bvh});
+  ScriptedBackend device;
+  std::vector<std::vector<ObjectId>> frames;
+  for (int frame = 0; frame < 2; ++frame) {
+    if (frame == 1) {
+      scene.set_transform(0, glm::mat4(1.0f));
+      bvh.refit(scene);
+      scene.clear_moved();
+    }
+    device.rendered.clear();
+    (void)soc->render_frame(camera(), device);
+    std::sort(device.rendered.begin(), device.rendered.end());
+    frames.push_back(device.rendered);
+  }
+  EXPECT_EQ(frames, (std::vector<std::vector<ObjectId>>{{0, 1}, {0}}));
+}
+
 TEST(Soc, AnOccluderWithoutVerticesOnTheCpuHidesNothing) {
   Scene scene("info");
   const MaterialId mat = scene.add_material({"grey", {0.7f, 0.7f, 0.7f, 1.0f}, false, 0});

@@ -60,18 +60,25 @@ class SocCuller final : public Culler {
     if (++frame_ == 0) {  // wrapped: no node may look shown last frame
       std::fill(shown_.begin(), shown_.end(), 0u);
       std::fill(prerasterized_.begin(), prerasterized_.end(), 0u);
+      std::fill(queued_.begin(), queued_.end(), 0u);
       frame_ = 2;
     }
 
     // The prepass: last frame's occluders still in the frustum, rasterized
-    // first in one batch (on the buffer's threads) and drawn this frame
-    // whatever the walk finds.
+    // first in one batch (on the buffer's threads), then each tested: one
+    // found visible is drawn whatever the walk finds. One found hidden is
+    // not drawn, and need not be: its polygons lie inside its box, so each
+    // of its texels' keys is no nearer than the box, and the buffer already
+    // holds a key nearer than the box at every texel the box reaches. Its
+    // rasterizing changed no texel, now or later (keys only come nearer):
+    // the buffer is what the drawn occluders alone make it.
     const std::size_t objects = index_.scene.objects().size();
-    if (prerasterized_.size() != objects) prerasterized_.assign(objects, 0);
+    if (prerasterized_.size() != objects) prerasterized_.assign(objects, 0), queued_.assign(objects, 0);
     std::swap(last_occluders_, occluders_drawn_);
     occluders_drawn_.clear();
     if (config_.prepass) {
       draws_.clear();
+      prepassed_.clear();
       for (const ObjectId id : last_occluders_) {
         if (id >= objects) continue;
         const Object& o = index_.scene.object(id);
@@ -79,10 +86,15 @@ class SocCuller final : public Culler {
         const std::optional<OcclusionBuffer::OccluderDraw> draw = occluders_.occluder_draw(id, o.bounds, view);
         if (!draw) continue;
         draws_.push_back(*draw);
+        prepassed_.push_back(id);
         prerasterized_[id] = frame_;
-        queue_.push_back(id);
       }
       occluders_.rasterize(buffer, draws_, view, counters);
+      for (const ObjectId id : prepassed_)
+        if (!test_box(buffer, index_.scene.object(id).bounds, view.view_proj, counters)) {
+          queue_.push_back(id);
+          queued_[id] = frame_;
+        }
     }
 
     DistanceQueue open;
@@ -107,8 +119,9 @@ class SocCuller final : public Culler {
         const Aabb& box = tested ? bvh.node(n).bounds : index_.scene.object(id).bounds;
         if (!tested && test_box(buffer, box, view.view_proj, counters)) continue;
         if (prerasterized_[id] == frame_) {
-          // Queued and rasterized by the prepass (its own polygons cannot hide its box: they lie inside it);
-          // in the next prepass only if found visible again.
+          // Rasterized by the prepass; in the next prepass only if found visible again. (Found hidden after the
+          // prepass, it cannot be visible now: drawing it anyway is safe.)
+          if (queued_[id] != frame_) queue_.push_back(id), queued_[id] = frame_;
           occluders_drawn_.push_back(id);
         } else {
           queue_.push_back(id);
@@ -142,7 +155,9 @@ class SocCuller final : public Culler {
   std::vector<ObjectId> queue_, leaf_;
   std::vector<ObjectId> occluders_drawn_, last_occluders_;  // occluders rasterized this frame, and last
   std::vector<std::uint32_t> prerasterized_;  // per object: the last frame_ the prepass rasterized it
-  std::vector<OcclusionBuffer::OccluderDraw> draws_;  // the prepass's (scratch)
+  std::vector<std::uint32_t> queued_;         // per object: the last frame_ the prepass queued it to be drawn
+  std::vector<ObjectId> prepassed_;           // the prepass's objects (scratch)
+  std::vector<OcclusionBuffer::OccluderDraw> draws_;  // and their draws (scratch)
   std::vector<std::uint32_t> shown_;  // per node: the last frame_ it held a drawn object (0: none)
   std::uint32_t frame_ = 1;
   std::uint64_t generation_ = 0;      // of the hierarchy shown_ follows
