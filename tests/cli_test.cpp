@@ -239,7 +239,7 @@ TEST(Cli, RenderTakesTheAlgorithmSpecsBenchTakes) {
 TEST(Cli, RenderShowsTheOcclusionBufferBesideTheFrame) {
   const std::string out = ::testing::TempDir() + "occull_cli_soc.png";
   std::remove(out.c_str());
-  CliRun r = run(std::string("render ") + kTinyCity + " --algo soc --view soc --frame 2 --frames 5 --out " + out);
+  CliRun r = run(std::string("render ") + kTinyCity + " --algo soc:scale=4 --view soc --frame 2 --frames 5 --out " + out);
   ASSERT_EQ(r.code, 0) << r.output;
   EXPECT_NE(r.output.find("(128x48)"), std::string::npos) << r.output;  // the frame and the buffer, side by side
   EXPECT_NE(r.output.find("the occlusion buffer, 16x12 texels"), std::string::npos) << r.output;

@@ -237,7 +237,7 @@ TEST(CpuTestBackend, ThreadsAnswerAsOneThreadDoes) {
   EXPECT_LT(runs["chcpp:virtual_leaf=0:cpu_test=on"].second, runs["chcpp:virtual_leaf=0"].second);
 }
 
-// soc:prepass=on rasterizes last frame's occluders before its walk, so it
+// soc's prepass (on by default) rasterizes last frame's occluders before its walk, so it
 // must draw them whatever the walk finds (a rasterized occluder that is not
 // drawn could hide what lies behind it on screen), and carries into the next
 // prepass only those its walk found visible again. A back wall is seen,
@@ -249,7 +249,7 @@ TEST(Soc, ThePrepassDrawsLastFramesOccludersAndCarriesOnlyThoseFoundVisible) {
   const glm::mat4 aside = glm::translate(glm::mat4(1.0f), glm::vec3(500.0f, 0.0f, 0.0f));
   Bvh bvh = Bvh::build(scene);
   std::map<std::string, std::vector<std::vector<ObjectId>>> frames;
-  for (const char* spec : {"soc:prepass=on", "soc"}) {
+  for (const char* spec : {"soc", "soc:prepass=off"}) {
     scene.set_transform(0, aside);
     bvh.refit(scene);
     scene.clear_moved();
@@ -268,8 +268,8 @@ TEST(Soc, ThePrepassDrawsLastFramesOccludersAndCarriesOnlyThoseFoundVisible) {
     }
   }
   using Ids = std::vector<ObjectId>;
-  EXPECT_EQ(frames["soc:prepass=on"], (std::vector<Ids>{{1}, {0, 1}, {0}}));
-  EXPECT_EQ(frames["soc"], (std::vector<Ids>{{1}, {0}, {0}}));
+  EXPECT_EQ(frames["soc"], (std::vector<Ids>{{1}, {0, 1}, {0}}));
+  EXPECT_EQ(frames["soc:prepass=off"], (std::vector<Ids>{{1}, {0}, {0}}));
 }
 
 // soc's threads (soc:threads, the buffer's own) share its prepass and its
@@ -278,9 +278,9 @@ TEST(Soc, ThreadsDrawWhatOneThreadDraws) {
   const std::vector<Aabb> boxes = rows_of_boxes();
   const Scene scene = test::box_scene(boxes);
   const Bvh bvh = Bvh::build(scene);
-  for (const char* scale : {"", ":scale=1"}) {
+  for (const char* scale : {"", ":scale=4"}) {
     std::map<std::string, std::vector<std::vector<ObjectId>>> frames;
-    const std::string one = std::string("soc:prepass=on") + scale, three = one + ":threads=3";
+    const std::string one = std::string("soc:threads=1") + scale, three = std::string("soc:threads=3") + scale;
     for (const std::string& spec : {one, three}) {
       auto soc = make_culler(spec, {scene, bvh});
       ScriptedBackend device;
@@ -308,7 +308,7 @@ TEST(Soc, APrepassedOccluderFoundHiddenAfterThePrepassIsNotDrawn) {
   scene.set_transform(0, glm::translate(glm::mat4(1.0f), glm::vec3(40.0f, 0.0f, 0.0f)));
   bvh.refit(scene);
   scene.clear_moved();
-  auto soc = make_culler("soc:prepass=on", {scene, bvh});
+  auto soc = make_culler("soc", {scene, bvh});
   ScriptedBackend device;
   std::vector<std::vector<ObjectId>> frames;
   for (int frame = 0; frame < 2; ++frame) {

@@ -134,14 +134,18 @@ struct OccluderChoice {
 /// occluders (meshes with CPU vertices) rasterized front to back, no queries.
 struct SocConfig {
   static constexpr std::string_view algorithm = "soc";
-  int scale = 4;   ///< buffer = viewport / scale on each axis; in [1, 64]
+  /// Buffer = viewport / scale on each axis; in [0, 64]. 0: about
+  /// `auto_width` texels across whatever the view (scale = view width /
+  /// auto_width, at least 1: 1 at 320×180, 4 at 1280×720, 6 at 1920×1080).
+  int scale = 0;
+  static constexpr int auto_width = 320;
   int width = 0;   ///< explicit buffer width in texels; in [0, 8192], 0: from scale
   int height = 0;  ///< explicit buffer height in texels; in [0, 8192], 0: from scale
   OccluderChoice occluders;
   bool simd = true;  ///< vectorised inner loops (off: the scalar reference, equal bit for bit)
   bool fuse = true;  ///< fused pairs (OcclusionBuffer rule 11): polygons sharing an edge cover the seam between them
-  int threads = 1;   ///< threads rasterizing an occluder of many polygons, and the prepass (OcclusionBuffer::set_threads); in [1, 64]
-  bool prepass = false;  ///< last frame's occluders still in the frustum rasterized first, as one batch, and drawn
+  int threads = 2;   ///< threads rasterizing the prepass and an occluder of many polygons (OcclusionBuffer::set_threads); in [1, 64]
+  bool prepass = true;  ///< last frame's occluders still in the frustum rasterized first, as one batch; those then visible drawn
 };
 
 /// GPU-driven two-phase depth-pyramid culling; needs a backend with device

@@ -137,8 +137,9 @@ class SocCuller final : public Culler {
 
  private:
   OcclusionBuffer& buffer_for(const View& view) {
-    const int w = config_.width > 0 ? config_.width : std::max(1, view.width / config_.scale);
-    const int h = config_.height > 0 ? config_.height : std::max(1, view.height / config_.scale);
+    const int scale = config_.scale > 0 ? config_.scale : std::max(1, view.width / SocConfig::auto_width);
+    const int w = config_.width > 0 ? config_.width : std::max(1, view.width / scale);
+    const int h = config_.height > 0 ? config_.height : std::max(1, view.height / scale);
     const SimdPath simd = config_.simd ? SimdPath::best : SimdPath::scalar;
     if (!buffer_ || buffer_->width() != w || buffer_->height() != h) buffer_.emplace(w, h, simd);
     buffer_->set_fused_pairs(config_.fuse);
@@ -168,7 +169,9 @@ class SocCuller final : public Culler {
 Registration soc_registration() {
   static const ConfigTable<SocConfig> table =
       ConfigTable<SocConfig>()
-          .integer("scale", &SocConfig::scale, 1, 64, "occlusion buffer = viewport / scale on each axis")
+          .integer("scale", &SocConfig::scale, 0, 64,
+                   "occlusion buffer = viewport / scale on each axis (0: about 320 texels across, scale = view width "
+                   "/ 320, at least 1)")
           .integer("width", &SocConfig::width, 0, 8192, "occlusion buffer width in texels (0: from scale)")
           .integer("height", &SocConfig::height, 0, 8192, "occlusion buffer height in texels (0: from scale)")
           .integer("budget", [](auto& c) -> auto& { return c.occluders.budget; }, 0, 1 << 30,
