@@ -144,7 +144,10 @@ struct SocConfig {
   OccluderChoice occluders;
   bool simd = true;  ///< vectorised inner loops (off: the scalar reference, equal bit for bit)
   bool fuse = true;  ///< fused pairs (OcclusionBuffer rule 11): polygons sharing an edge cover the seam between them
-  int threads = 2;   ///< threads rasterizing the prepass and an occluder of many polygons (OcclusionBuffer::set_threads); in [1, 64]
+  /// Threads rasterizing the prepass and an occluder of many polygons
+  /// (OcclusionBuffer::set_threads); in [0, 64]. 0: two, one on a machine
+  /// of one hardware thread.
+  int threads = 0;
   bool prepass = true;  ///< last frame's occluders still in the frustum rasterized first, as one batch; those then visible drawn
 };
 

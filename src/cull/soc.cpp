@@ -30,7 +30,9 @@
 #include "occluders.hpp"
 #include "occull/occlusion_buffer.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <thread>
 #include <optional>
 
 namespace occull::detail {
@@ -143,7 +145,8 @@ class SocCuller final : public Culler {
     const SimdPath simd = config_.simd ? SimdPath::best : SimdPath::scalar;
     if (!buffer_ || buffer_->width() != w || buffer_->height() != h) buffer_.emplace(w, h, simd);
     buffer_->set_fused_pairs(config_.fuse);
-    buffer_->set_threads(config_.threads);
+    buffer_->set_threads(config_.threads > 0 ? config_.threads
+                                              : int(std::clamp(std::thread::hardware_concurrency(), 1u, 2u)));
     return *buffer_;
   }
 
@@ -181,12 +184,12 @@ Registration soc_registration() {
           .real("detail", [](auto& c) -> auto& { return c.occluders.detail; }, 0.0, 1e6,
                 "an occluder's polygons whose inscribed circle is below 1/detail of its largest are not rasterized "
                 "(0: all)")
-          .integer("threads", &SocConfig::threads, 1, OcclusionBuffer::max_threads,
-                   "threads rasterizing an occluder of many polygons (the caller's and the buffer's own; the buffer "
-                   "is the same whatever the threads)")
+          .integer("threads", &SocConfig::threads, 0, OcclusionBuffer::max_threads,
+                   "threads rasterizing the prepass and an occluder of many polygons (the caller's and the buffer's "
+                   "own; the buffer is the same whatever the threads; 0: two, one on a one-thread machine)")
           .flag("prepass", &SocConfig::prepass,
                 "last frame's occluders still in the frustum rasterized first, in one batch shared among the "
-                "threads, and drawn whatever the walk finds")
+                "threads; those then found visible drawn whatever the walk finds")
           .flag("simd", &SocConfig::simd, "vectorised inner loops (off: the scalar reference, equal bit for bit)")
           .flag("fuse", &SocConfig::fuse,
                 "polygons of an occluder that share an edge cover the seam between them (the buffer's rule 11; off: "
