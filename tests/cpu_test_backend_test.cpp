@@ -28,6 +28,21 @@ Scene wall_scene() {
 
 View camera() { return make_view(CameraPose{}, Lens{60.0f, 0.1f, 100.0f}, 320, 180); }
 
+// Moves object `id` as an engine does between frames: the hierarchy refitted, the moves taken.
+void move(Scene& scene, Bvh& bvh, ObjectId id, const glm::mat4& transform) {
+  scene.set_transform(id, transform);
+  bvh.refit(scene);
+  scene.clear_moved();
+}
+
+// What `culler` draws of a frame seen through `view`, sorted.
+std::vector<ObjectId> drawn_in_frame(Culler& culler, const View& view, ScriptedBackend& device) {
+  device.rendered.clear();
+  (void)culler.render_frame(view, device);
+  std::sort(device.rendered.begin(), device.rendered.end());
+  return device.rendered;
+}
+
 TEST(CpuTestBackend, AQueryOfBoxesBehindADrawnOccluderIsAnsweredWithoutTheDevice) {
   const Scene scene = wall_scene();
   const View view = camera();
@@ -250,21 +265,12 @@ TEST(Soc, ThePrepassDrawsLastFramesOccludersAndCarriesOnlyThoseFoundVisible) {
   Bvh bvh = Bvh::build(scene);
   std::map<std::string, std::vector<std::vector<ObjectId>>> frames;
   for (const char* spec : {"soc", "soc:prepass=off"}) {
-    scene.set_transform(0, aside);
-    bvh.refit(scene);
-    scene.clear_moved();
+    move(scene, bvh, 0, aside);
     auto soc = make_culler(spec, {scene, bvh});
     ScriptedBackend device;
     for (int frame = 0; frame < 3; ++frame) {
-      if (frame == 1) {  // the front wall back in front of the back wall
-        scene.set_transform(0, glm::mat4(1.0f));
-        bvh.refit(scene);
-        scene.clear_moved();
-      }
-      device.rendered.clear();
-      (void)soc->render_frame(camera(), device);
-      std::sort(device.rendered.begin(), device.rendered.end());
-      frames[spec].push_back(device.rendered);
+      if (frame == 1) move(scene, bvh, 0, glm::mat4(1.0f));  // the front wall back in front of the back wall
+      frames[spec].push_back(drawn_in_frame(*soc, camera(), device));
     }
   }
   using Ids = std::vector<ObjectId>;
@@ -284,12 +290,7 @@ TEST(Soc, ThreadsDrawWhatOneThreadDraws) {
     for (const std::string& spec : {one, three}) {
       auto soc = make_culler(spec, {scene, bvh});
       ScriptedBackend device;
-      for (int frame = 0; frame < 6; ++frame) {
-        device.rendered.clear();
-        (void)soc->render_frame(moving_camera(frame), device);
-        std::sort(device.rendered.begin(), device.rendered.end());
-        frames[spec].push_back(device.rendered);
-      }
+      for (int frame = 0; frame < 6; ++frame) frames[spec].push_back(drawn_in_frame(*soc, moving_camera(frame), device));
     }
     EXPECT_EQ(frames[three], frames[one]) << scale;
     EXPECT_LT(frames[one].back().size(), boxes.size() / 2) << scale;  // it culls: rows hide rows
@@ -305,22 +306,13 @@ TEST(Soc, APrepassedOccluderFoundHiddenAfterThePrepassIsNotDrawn) {
   Scene scene = test::box_scene({{{-40, -40, -11}, {40, 40, -10}},   // 0: the front wall, half over the back one at first
                                  {{-20, -20, -31}, {20, 20, -30}}});  // 1: the back wall
   Bvh bvh = Bvh::build(scene);
-  scene.set_transform(0, glm::translate(glm::mat4(1.0f), glm::vec3(40.0f, 0.0f, 0.0f)));
-  bvh.refit(scene);
-  scene.clear_moved();
+  move(scene, bvh, 0, glm::translate(glm::mat4(1.0f), glm::vec3(40.0f, 0.0f, 0.0f)));
   auto soc = make_culler("soc", {scene, bvh});
   ScriptedBackend device;
   std::vector<std::vector<ObjectId>> frames;
   for (int frame = 0; frame < 2; ++frame) {
-    if (frame == 1) {
-      scene.set_transform(0, glm::mat4(1.0f));
-      bvh.refit(scene);
-      scene.clear_moved();
-    }
-    device.rendered.clear();
-    (void)soc->render_frame(camera(), device);
-    std::sort(device.rendered.begin(), device.rendered.end());
-    frames.push_back(device.rendered);
+    if (frame == 1) move(scene, bvh, 0, glm::mat4(1.0f));
+    frames.push_back(drawn_in_frame(*soc, camera(), device));
   }
   EXPECT_EQ(frames, (std::vector<std::vector<ObjectId>>{{0, 1}, {0}}));
 }

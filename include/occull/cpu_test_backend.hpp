@@ -30,7 +30,9 @@ class CpuTestBackend final : public Backend {
     double min_texels = 2.0;  ///< occluders spanning fewer texels across are not rasterized
     double detail = 8.0;      ///< polygons below 1/detail of their mesh's largest inscribed circle left out (0: none)
     SimdPath simd = SimdPath::best;
-    int threads = 1;          ///< threads rasterizing each batch drawn (OcclusionBuffer::set_threads), in [1, 64]
+    /// Threads rasterizing each batch drawn (OcclusionBuffer::set_threads), in
+    /// [1, 64]; another makes begin_frame throw UsageError.
+    int threads = 1;
   };
 
   /// Prepares the occluder meshes of `scene`'s objects. Precondition:

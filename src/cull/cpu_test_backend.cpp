@@ -2,7 +2,6 @@
 
 #include "occluders.hpp"
 #include "occull/error.hpp"
-#include "core/format.hpp"
 
 #include <algorithm>
 #include <optional>
@@ -55,11 +54,7 @@ struct CpuTestBackend::Impl {
 };
 
 CpuTestBackend::CpuTestBackend(const Scene& scene, const Options& options)
-    : impl_(std::make_unique<Impl>(scene, options)) {
-  if (options.threads < 1 || options.threads > OcclusionBuffer::max_threads)
-    throw UsageError(detail::format("CpuTestBackend: {} threads (in [1, {}])", options.threads,
-                                    OcclusionBuffer::max_threads));
-}
+    : impl_(std::make_unique<Impl>(scene, options)) {}
 CpuTestBackend::~CpuTestBackend() = default;
 
 void CpuTestBackend::begin_frame(Backend& inner, const View& view) {

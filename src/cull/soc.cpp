@@ -32,8 +32,8 @@
 
 #include <algorithm>
 #include <cmath>
-#include <thread>
 #include <optional>
+#include <thread>
 
 namespace occull::detail {
 namespace {
@@ -41,7 +41,10 @@ namespace {
 class SocCuller final : public Culler {
  public:
   SocCuller(const SceneIndex& index, const SocConfig& config)
-      : index_(index), config_(config), occluders_(index.scene, config.occluders) {}
+      : index_(index),
+        config_(config),
+        occluders_(index.scene, config.occluders),
+        threads_(config.threads > 0 ? config.threads : int(std::clamp(std::thread::hardware_concurrency(), 1u, 2u))) {}
 
   void visit_counters(const CounterVisitor& visit) const override { counters_.visit(visit); }
 
@@ -145,14 +148,14 @@ class SocCuller final : public Culler {
     const SimdPath simd = config_.simd ? SimdPath::best : SimdPath::scalar;
     if (!buffer_ || buffer_->width() != w || buffer_->height() != h) buffer_.emplace(w, h, simd);
     buffer_->set_fused_pairs(config_.fuse);
-    buffer_->set_threads(config_.threads > 0 ? config_.threads
-                                              : int(std::clamp(std::thread::hardware_concurrency(), 1u, 2u)));
+    buffer_->set_threads(threads_);
     return *buffer_;
   }
 
   SceneIndex index_;
   SocConfig config_;
   Occluders occluders_;
+  int threads_;  // config_.threads, 0 resolved once (hardware_concurrency may read /sys)
   BufferCounters counters_;  // of the last frame
   std::optional<OcclusionBuffer> buffer_;
   FrustumCache frustum_;
