@@ -323,17 +323,16 @@ class OcclusionBuffer {
 
  private:
   /// A vertex in clip space, where it lies against the clip planes, and
-  /// (once a polygon in front of the near plane needs them) its texel
+  /// (where it lies inside the near plane and the guard band) its texel
   /// coordinates, depth key and snapped coordinates: what every polygon at
   /// that corner needs of it.
   struct ClipVertex {
     glm::dvec4 clip;
-    glm::dvec3 window;     // texel x, y and the depth key; when projected
-    std::int64_t x, y;     // window x, y snapped to 1/256 texel; when projected
+    glm::dvec3 window;     // texel x, y and the depth key; set when inside
+    std::int64_t x, y;     // window x, y snapped to 1/256 texel; set when inside
     unsigned outside;      // bits: beyond x = w, x = -w, y = w, y = -w
     bool crossing_near;    // behind the near plane, or w <= 0
     bool inside;           // inside the near plane and the guard band
-    bool projected;        // window, x and y are set
   };
   [[nodiscard]] ClipVertex classify(const glm::dvec4& clip) const;
   /// What one thread writes while rasterizing: the texels' keys and the
@@ -367,7 +366,6 @@ class OcclusionBuffer {
   /// Merges lane's keys into the buffer's (the nearest kept), and empties them.
   void merge(Lane& lane);
   /// Sets v's window, x and y if not yet. Precondition: !v.crossing_near.
-  void project_once(ClipVertex& v) const;
   [[nodiscard]] glm::dvec3 project(const glm::dvec4& clip) const;
   /// Starts a call rasterizing polygons of `vertices` positions on `lane`:
   /// no vertex transformed yet.
@@ -406,6 +404,7 @@ class OcclusionBuffer {
 
   int width_, height_;
   int tiles_x_, tiles_y_;
+  double guard_;  // the guard band's reach in clip space, as a multiple of w (guard_band)
   SimdPath simd_;
   detail::OcclusionRules rules_;
   ClipSpace clip_;

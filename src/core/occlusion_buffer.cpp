@@ -57,6 +57,14 @@ std::int64_t snap(double v) {
   return std::int64_t((v * double(kSub) + kMagic) - kMagic);
 }
 
+// The corner after corner i of a polygon of n corners (a modulo by a
+// variable costs an integer division: this path runs per polygon).
+constexpr int next_corner(int i, int n) { return i + 1 == n ? 0 : i + 1; }
+
+// Every coordinate of a clipped vertex lies within 2^19 texels of the
+// buffer: 2^27 fixed-point steps, so edge functions stay within int64.
+double guard_band(int width, int height) { return double(1 << 20) / double(std::max(width, height)) - 1.0; }
+
 // A hash table of 32-bit values by key, open addressing with linear
 // probing, for make_occluder_mesh's welding and edges: one allocation, no
 // node a key (docs/performance.md: preparing a city's meshes took twice as
@@ -287,6 +295,7 @@ OcclusionBuffer::OcclusionBuffer(int width, int height, SimdPath simd, const det
       height_(height),
       tiles_x_((width + tile_size - 1) / tile_size),
       tiles_y_((height + tile_size - 1) / tile_size),
+      guard_(guard_band(width, height)),
       simd_(simd),
       rules_(rules),
       keys_(std::size_t(width) * std::size_t(height), kInf),
@@ -576,7 +585,7 @@ void OcclusionBuffer::raster_mesh_polygon(Lane& lane, std::span<const glm::vec3>
   for (int k = 0; k < n; ++k) {
     const std::uint32_t q = mesh.neighbours[4 * p + std::size_t(k)];
     if (q >= p) continue;  // no_corner too
-    const ClipVertex &a = *v[k], &b = *v[(k + 1) % n];
+    const ClipVertex &a = *v[k], &b = *v[next_corner(k, n)];
     const TexelRect r{int(std::max<std::int64_t>(0, -floor_div(far_side - (std::min(a.x, b.x) - kGrow), kSub))),
                       int(std::min<std::int64_t>(width_ - 1, floor_div(std::max(a.x, b.x) + kGrow - near_side, kSub))),
                       int(std::max<std::int64_t>(0, -floor_div(far_side - (std::min(a.y, b.y) - kGrow), kSub))),
@@ -597,12 +606,11 @@ OcclusionBuffer::Edge OcclusionBuffer::not_wholly_inside(const Edge& e) { return
 
 // Whether polygon corners c lie where the GPU draws them unclipped (inside
 // the near plane, and within twice the viewport's extent: rule 11 assumes
-// the GPU's guard band reaches that far); projected then.
+// the GPU's guard band reaches that far).
 bool OcclusionBuffer::drawn_whole(ClipVertex* const* c, int count) const {
   for (int i = 0; i < count; ++i) {
     const glm::dvec4& x = c[i]->clip;
     if (!c[i]->inside || !(std::abs(x.x) <= 2.0 * x.w) || !(std::abs(x.y) <= 2.0 * x.w)) return false;
-    project_once(*c[i]);
   }
   return true;
 }
@@ -627,7 +635,7 @@ bool OcclusionBuffer::might_cover(const Edge* edges, int count, const TexelRect&
 void OcclusionBuffer::fuse_edge(Lane& lane, std::span<const glm::vec3> positions, const OccluderMesh& mesh,
                                 ClipVertex* const* v, int n, int k, std::uint32_t q, const TexelRect& r,
                                 const Edge* band, const glm::dmat4& object_to_clip) const {
-  const int k1 = (k + 1) % n;
+  const int k1 = next_corner(k, n);
   std::int64_t XA[4], YA[4];
   for (int i = 0; i < n; ++i) XA[i] = v[i]->x, YA[i] = v[i]->y;
   // Inside A's other edges and B's, grown: on A's side of the shared edge
@@ -636,7 +644,7 @@ void OcclusionBuffer::fuse_edge(Lane& lane, std::span<const glm::vec3> positions
   Edge edges[kMaxEdges] = {band[0], band[1]};
   int count = 2;
   for (int i = 0; i < n && rules_.fusion_other_edges; ++i) {
-    const int i1 = (i + 1) % n;
+    const int i1 = next_corner(i, n);
     if (i != k && !(XA[i] == XA[i1] && YA[i] == YA[i1])) edges[count++] = make_edge(XA, YA, i, i1);
   }
   if (!might_cover(edges, count, r)) return;
@@ -653,11 +661,11 @@ void OcclusionBuffer::fuse_edge(Lane& lane, std::span<const glm::vec3> positions
   // B's edge j runs back along A's edge k (the same positions snap alike).
   int j = -1;
   for (int i = 0; i < m; ++i)
-    if (XB[i] == XA[k1] && YB[i] == YA[k1] && XB[(i + 1) % m] == XA[k] && YB[(i + 1) % m] == YA[k]) j = i;
+    if (XB[i] == XA[k1] && YB[i] == YA[k1] && XB[next_corner(i, m)] == XA[k] && YB[next_corner(i, m)] == YA[k]) j = i;
   if (j < 0) return;
   if (!(surely_front_facing(XA, YA, n) && surely_front_facing(XB, YB, m))) return;
   for (int i = 0; i < m && rules_.fusion_other_edges; ++i) {
-    const int i1 = (i + 1) % m;
+    const int i1 = next_corner(i, m);
     if (i != j && !(XB[i] == XB[i1] && YB[i] == YB[i1])) edges[count++] = make_edge(XB, YB, i, i1);
   }
   DepthPlane plane, other;
@@ -680,9 +688,6 @@ void OcclusionBuffer::fuse_edge(Lane& lane, std::span<const glm::vec3> positions
 }
 
 namespace {
-// Every coordinate of a clipped vertex lies within 2^19 texels of the
-// buffer: 2^27 fixed-point steps, so edge functions stay within int64.
-double guard_band(int width, int height) { return double(1 << 20) / double(std::max(width, height)) - 1.0; }
 constexpr int kPlanes = 5;  // the near plane, then the guard band's four sides
 }  // namespace
 
@@ -696,7 +701,7 @@ glm::dvec3 OcclusionBuffer::project(const glm::dvec4& c) const {
 }
 
 OcclusionBuffer::ClipVertex OcclusionBuffer::classify(const glm::dvec4& c) const {
-  const double guard = guard_band(width_, height_);
+  const double guard = guard_;
   ClipVertex out{};
   out.clip = c;
   out.outside = unsigned(c.x > c.w) | unsigned(c.x < -c.w) << 1 | unsigned(c.y > c.w) << 2 | unsigned(c.y < -c.w) << 3;
@@ -706,22 +711,19 @@ OcclusionBuffer::ClipVertex OcclusionBuffer::classify(const glm::dvec4& c) const
   out.crossing_near = !(near >= 0.0) || !(c.w > 0.0);
   out.inside = !out.crossing_near && guard * c.w - c.x >= 0.0 && guard * c.w + c.x >= 0.0 &&
                guard * c.w - c.y >= 0.0 && guard * c.w + c.y >= 0.0;
+  if (out.inside) {  // projected now: the polygons chosen face the eye, and nearly all such corners are drawn
+    out.window = project(c);
+    out.x = snap(out.window.x);
+    out.y = snap(out.window.y);
+  }
   return out;
-}
-
-void OcclusionBuffer::project_once(ClipVertex& v) const {
-  if (v.projected) return;
-  v.window = project(v.clip);
-  v.x = snap(v.window.x);
-  v.y = snap(v.window.y);
-  v.projected = true;
 }
 
 // Rule 1: clips a convex polygon at the near plane and the guard band (in
 // double, Sutherland-Hodgman), then rasterizes what is left. True when the
 // polygon needed no clipping and faces the eye (its corners projected).
 bool OcclusionBuffer::raster_clipped(Lane& lane, ClipVertex* const* v, int vertices) const {
-  const double guard = guard_band(width_, height_);
+  const double guard = guard_;
   const double near_depth = clip_.near_depth();
   const auto distance = [&](const glm::dvec4& c, int plane) -> double {
     switch (plane) {
@@ -756,12 +758,11 @@ bool OcclusionBuffer::raster_clipped(Lane& lane, ClipVertex* const* v, int verti
   if (inside) {  // most: no plane to clip at, and the corners are projected and snapped already
     std::int64_t X[4], Y[4];
     for (int i = 0; i < vertices; ++i) {
-      project_once(*v[i]);
       s[i] = v[i]->window, X[i] = v[i]->x, Y[i] = v[i]->y;
     }
     if (double area = 0.0; rules_.front_faces_only) {
       for (int i = 0; i < vertices; ++i)
-        area += s[i].x * s[(i + 1) % vertices].y - s[(i + 1) % vertices].x * s[i].y;
+        area += s[i].x * s[next_corner(i, vertices)].y - s[next_corner(i, vertices)].x * s[i].y;
       if (!(area > 0.0)) return false;  // rule 2: front faces only
       raster_snapped(lane, s, X, Y, vertices);
       return true;
@@ -784,7 +785,7 @@ bool OcclusionBuffer::raster_clipped(Lane& lane, ClipVertex* const* v, int verti
     if (!any_out) continue;
     int m = 0;
     for (int i = 0; i < n; ++i) {
-      const int j = (i + 1) % n;
+      const int j = next_corner(i, n);
       if (d[i] >= 0.0) next[m++] = poly[i];
       if ((d[i] >= 0.0) != (d[j] >= 0.0)) next[m++] = poly[i] + (poly[j] - poly[i]) * (d[i] / (d[i] - d[j]));
     }
@@ -801,7 +802,7 @@ void OcclusionBuffer::raster_polygon(Lane& lane, const glm::dvec3* in, int n) co
   assert(n >= 3 && n <= kMax);
   // Rule 2: front faces only (counter-clockwise with y up).
   double area = 0.0;
-  for (int i = 0; i < n; ++i) area += in[i].x * in[(i + 1) % n].y - in[(i + 1) % n].x * in[i].y;
+  for (int i = 0; i < n; ++i) area += in[i].x * in[next_corner(i, n)].y - in[next_corner(i, n)].x * in[i].y;
   glm::dvec3 v[kMax];
   if (area > 0.0) {
     std::copy(in, in + n, v);
@@ -835,7 +836,7 @@ OcclusionBuffer::Edge OcclusionBuffer::make_edge(const std::int64_t* X, const st
 [[gnu::always_inline]] inline int OcclusionBuffer::polygon_edges(const std::int64_t* X, const std::int64_t* Y, int n, Edge* edges) const {
   int edge_count = 0;
   for (int i = 0; i < n; ++i) {
-    const int j = (i + 1) % n;
+    const int j = next_corner(i, n);
     if (X[i] == X[j] && Y[i] == Y[j]) continue;  // snapped onto its neighbour
     edges[edge_count++] = make_edge(X, Y, i, j);
   }
@@ -881,7 +882,7 @@ OcclusionBuffer::Edge OcclusionBuffer::make_edge(const std::int64_t* X, const st
 void OcclusionBuffer::raster_snapped(Lane& lane, const glm::dvec3* v, const std::int64_t* X, const std::int64_t* Y,
                                      int n) const {
   std::int64_t snapped_area = 0;
-  for (int k = 0; k < n; ++k) snapped_area += X[k] * Y[(k + 1) % n] - X[(k + 1) % n] * Y[k];
+  for (int k = 0; k < n; ++k) snapped_area += X[k] * Y[next_corner(k, n)] - X[next_corner(k, n)] * Y[k];
   if (snapped_area <= 0) return;  // degenerate once snapped
   const std::int64_t min_x = *std::min_element(X, X + n), max_x = *std::max_element(X, X + n);
   const std::int64_t min_y = *std::min_element(Y, Y + n), max_y = *std::max_element(Y, Y + n);
