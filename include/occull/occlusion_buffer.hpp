@@ -393,10 +393,12 @@ class OcclusionBuffer {
   void raster_snapped(Lane& lane, const glm::dvec3* v, const std::int64_t* X, const std::int64_t* Y, int n) const;
   static constexpr int kMaxEdges = 9;    ///< of a region: a polygon clipped at 5 planes, or a fused pair's band (rule 11)
   static constexpr int kFewTexels = 16;  ///< a region of at most this many texels is tested texel by texel
+  static constexpr int kShortSpan = 8;   ///< a row span shorter than this is filled inline, not through SIMD dispatch
   [[nodiscard]] Edge make_edge(const std::int64_t* X, const std::int64_t* Y, int i, int j) const;
   int polygon_edges(const std::int64_t* X, const std::int64_t* Y, int n, Edge* edges) const;
   bool depth_plane(const glm::dvec3* v, int n, DepthPlane& out) const;
-  void fill_region(Lane& lane, const Edge* edges, int edge_count, const TexelRect& r, const DepthPlane& plane) const;
+  template <class PlaneOf>  // PlaneOf: () -> const DepthPlane* (null: no plane)
+  void fill_region(Lane& lane, const Edge* edges, int edge_count, const TexelRect& r, PlaneOf&& plane_of) const;
   float tile_farthest(int tx, int ty);
   /// Half the side of what a texel must have inside a polygon to be covered
   /// (the texel, or with rule 10 its pixel centres' square), in texels.

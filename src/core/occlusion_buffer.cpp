@@ -684,7 +684,7 @@ void OcclusionBuffer::fuse_edge(Lane& lane, std::span<const glm::vec3> positions
                   (plane.off_plane + other.off_plane) * (2.0 + 6.0 / length);
     plane.cap = std::max(plane.cap, other.cap);
   }
-  fill_region(lane, edges, count, r, plane);
+  fill_region(lane, edges, count, r, [&] { return &plane; });
 }
 
 namespace {
@@ -909,17 +909,20 @@ void OcclusionBuffer::raster_snapped(Lane& lane, const glm::dvec3* v, const std:
   Edge edges[kMaxEdges];
   const int edge_count = polygon_edges(X, Y, n, edges);
   DepthPlane plane;
-  if (!depth_plane(v, n, plane)) return;
-  fill_region(lane, edges, edge_count, {x_lo, x_hi, y_lo, y_hi}, plane);
+  fill_region(lane, edges, edge_count, {x_lo, x_hi, y_lo, y_hi},
+              [&]() -> const DepthPlane* { return depth_plane(v, n, plane) ? &plane : nullptr; });
 }
 
-// Writes the depth bound into every texel of r
-// inside every edge.
+// Writes the depth bound into every texel of r inside every edge. The
+// depth plane is asked of plane_of() at the first row holding such a texel
+// (null: nothing written): at one pixel a texel most small polygons hold
+// none, and their plane, two divisions, is never needed.
+template <class PlaneOf>
 [[gnu::always_inline]] inline void OcclusionBuffer::fill_region(Lane& lane, const Edge* edges, int edge_count,
-                                                                 const TexelRect& r, const DepthPlane& plane) const {
+                                                                 const TexelRect& r, PlaneOf&& plane_of) const {
   const int x_lo = r.x_lo, x_hi = r.x_hi, y_lo = r.y_lo, y_hi = r.y_hi;
   const bool strict = rules_.inner_coverage;
-  const float step = float(plane.gx);
+  const DepthPlane* plane = nullptr;
   // Each edge bounds a row's covered texels on one side: e(tx) = s*tx + r(ty),
   // s = 256 a, r linear in ty. The bound floor(N/D) (N = -r, D = s when s > 0;
   // N = r, D = -s when s < 0) is stepped from row to row exactly, quotient
@@ -976,16 +979,17 @@ void OcclusionBuffer::raster_snapped(Lane& lane, const glm::dvec3* v, const std:
       if (b.rem >= b.d) b.rem -= b.d, ++b.q;
     }
     if (lo > hi) continue;
-    const double base_d = plane.p0.z + plane.gx * (double(lo) + plane.fx - plane.p0.x) +
-                          plane.gy * (double(ty) + plane.fy - plane.p0.y) + plane.bias;
+    if (!plane && !(plane = plane_of())) return;
+    const double base_d = plane->p0.z + plane->gx * (double(lo) + plane->fx - plane->p0.x) +
+                          plane->gy * (double(ty) + plane->fy - plane->p0.y) + plane->bias;
     float base = float(base_d);
     if (double(base) < base_d) base = next_up(base);
     float* row = lane.keys + std::size_t(ty) * std::size_t(width_) + std::size_t(lo);
     const int span = int(hi - lo + 1);
-    if (simd_ == SimdPath::best)
-      simd::fill_span(row, span, base, step, plane.cap);
-    else
-      fill_span_scalar(row, span, base, step, plane.cap);
+    if (simd_ == SimdPath::best && span >= kShortSpan)
+      simd::fill_span(row, span, base, float(plane->gx), plane->cap);
+    else  // a short span here, as the vector code fills its tail: no dispatch through a pointer
+      fill_span_scalar(row, span, base, float(plane->gx), plane->cap);
     std::uint8_t* dirty = lane.dirty + std::size_t(ty / tile_size) * std::size_t(tiles_x_);
     for (int t = int(lo) / tile_size; t <= int(hi) / tile_size; ++t) dirty[t] = 1;
   }
