@@ -22,7 +22,8 @@ namespace occull {
 namespace {
 
 constexpr float kInf = std::numeric_limits<float>::infinity();
-constexpr std::int64_t kSub = 256;        // fixed-point steps per texel (rule 3)
+constexpr int kSubBits = 8;
+constexpr std::int64_t kSub = std::int64_t(1) << kSubBits;  // fixed-point steps per texel (rule 3)
 constexpr std::int64_t kGrow = kSub / 64; // a texel grown by 1/64 on every side (rules 3, 5)
 constexpr double kGrowTexels = double(kGrow) / double(kSub);
 
@@ -44,7 +45,6 @@ constexpr double kGrowTexels = double(kGrow) / double(kSub);
   return best;
 }
 
-using detail::floor_div;
 using detail::floor_div_bounded;
 using detail::next_up;
 using detail::surely_front_facing;
@@ -56,6 +56,18 @@ std::int64_t snap(double v) {
   constexpr double kMagic = 6755399441055744.0;  // 1.5 * 2^52
   return std::int64_t((v * double(kSub) + kMagic) - kMagic);
 }
+
+// Twice the signed area of polygon s[0, n) on screen (x, y), its terms
+// summed from corner 0 on, the wrapping one last.
+double twice_area(const glm::dvec3* s, int n) {
+  double area = 0.0;
+  for (int i = 0; i + 1 < n; ++i) area += s[i].x * s[i + 1].y - s[i + 1].x * s[i].y;
+  return area + (s[n - 1].x * s[0].y - s[0].x * s[n - 1].y);
+}
+
+// The texel holding fixed-point coordinate v: floor(v / kSub), as an
+// arithmetic shift (C++20 defines >> on negative values so).
+constexpr std::int64_t texel_of(std::int64_t v) { return v >> kSubBits; }
 
 // The corner after corner i of a polygon of n corners (a modulo by a
 // variable costs an integer division: this path runs per polygon).
@@ -586,10 +598,10 @@ void OcclusionBuffer::raster_mesh_polygon(Lane& lane, std::span<const glm::vec3>
     const std::uint32_t q = mesh.neighbours[4 * p + std::size_t(k)];
     if (q >= p) continue;  // no_corner too
     const ClipVertex &a = *v[k], &b = *v[next_corner(k, n)];
-    const TexelRect r{int(std::max<std::int64_t>(0, -floor_div(far_side - (std::min(a.x, b.x) - kGrow), kSub))),
-                      int(std::min<std::int64_t>(width_ - 1, floor_div(std::max(a.x, b.x) + kGrow - near_side, kSub))),
-                      int(std::max<std::int64_t>(0, -floor_div(far_side - (std::min(a.y, b.y) - kGrow), kSub))),
-                      int(std::min<std::int64_t>(height_ - 1, floor_div(std::max(a.y, b.y) + kGrow - near_side, kSub)))};
+    const TexelRect r{int(std::max<std::int64_t>(0, -texel_of(far_side - (std::min(a.x, b.x) - kGrow)))),
+                      int(std::min<std::int64_t>(width_ - 1, texel_of(std::max(a.x, b.x) + kGrow - near_side))),
+                      int(std::max<std::int64_t>(0, -texel_of(far_side - (std::min(a.y, b.y) - kGrow)))),
+                      int(std::min<std::int64_t>(height_ - 1, texel_of(std::max(a.y, b.y) + kGrow - near_side)))};
     if (r.x_lo > r.x_hi || r.y_lo > r.y_hi || (a.x == b.x && a.y == b.y)) continue;
     // The band: squares that lie wholly on neither side of the shared edge
     // (grown), i.e. that neither polygon alone covers: not wholly inside
@@ -760,10 +772,8 @@ bool OcclusionBuffer::raster_clipped(Lane& lane, ClipVertex* const* v, int verti
     for (int i = 0; i < vertices; ++i) {
       s[i] = v[i]->window, X[i] = v[i]->x, Y[i] = v[i]->y;
     }
-    if (double area = 0.0; rules_.front_faces_only) {
-      for (int i = 0; i < vertices; ++i)
-        area += s[i].x * s[next_corner(i, vertices)].y - s[next_corner(i, vertices)].x * s[i].y;
-      if (!(area > 0.0)) return false;  // rule 2: front faces only
+    if (rules_.front_faces_only) {
+      if (!(twice_area(s, vertices) > 0.0)) return false;  // rule 2: front faces only
       raster_snapped(lane, s, X, Y, vertices);
       return true;
     }
@@ -801,8 +811,7 @@ void OcclusionBuffer::raster_polygon(Lane& lane, const glm::dvec3* in, int n) co
   constexpr int kMax = 9;
   assert(n >= 3 && n <= kMax);
   // Rule 2: front faces only (counter-clockwise with y up).
-  double area = 0.0;
-  for (int i = 0; i < n; ++i) area += in[i].x * in[next_corner(i, n)].y - in[next_corner(i, n)].x * in[i].y;
+  const double area = twice_area(in, n);
   glm::dvec3 v[kMax];
   if (area > 0.0) {
     std::copy(in, in + n, v);
@@ -897,11 +906,11 @@ void OcclusionBuffer::raster_snapped(Lane& lane, const glm::dvec3* v, const std:
   // shortcut: small polygons holding no such square stop here.
   const std::int64_t near_side = rules_.inner_coverage ? inset_ - kGrow : 0;
   const std::int64_t far_side = rules_.inner_coverage ? kSub - inset_ + kGrow : kSub;
-  const auto first = [&](std::int64_t lo) { return -floor_div(near_side - lo, kSub); };  // ceil((lo - near) / kSub)
-  const auto last = [&](std::int64_t hi) { return floor_div(hi - (rules_.inner_coverage ? far_side : 0), kSub); };
-  const int x_lo = int(std::max<std::int64_t>(0, rules_.inner_coverage ? first(min_x) : floor_div(min_x, kSub)));
+  const auto first = [&](std::int64_t lo) { return -texel_of(near_side - lo); };  // ceil((lo - near) / kSub)
+  const auto last = [&](std::int64_t hi) { return texel_of(hi - (rules_.inner_coverage ? far_side : 0)); };
+  const int x_lo = int(std::max<std::int64_t>(0, rules_.inner_coverage ? first(min_x) : texel_of(min_x)));
   const int x_hi = int(std::min<std::int64_t>(width_ - 1, last(max_x)));
-  const int y_lo = int(std::max<std::int64_t>(0, rules_.inner_coverage ? first(min_y) : floor_div(min_y, kSub)));
+  const int y_lo = int(std::max<std::int64_t>(0, rules_.inner_coverage ? first(min_y) : texel_of(min_y)));
   const int y_hi = int(std::min<std::int64_t>(height_ - 1, last(max_y)));
   if (x_lo > x_hi || y_lo > y_hi) return;
   // Edge i runs from vertex i to i+1. (A polygon that snapping left not
