@@ -174,7 +174,10 @@ enum class SimdPath : std::uint8_t {
 /// Built once per mesh.
 struct OccluderMesh {
   static constexpr std::uint32_t no_corner = 0xffffffffu;  ///< a triangle's fourth corner
-  std::vector<std::uint32_t> corners;  ///< 4 per polygon, counter-clockwise; no_corner last for a triangle
+  /// 4 per polygon, counter-clockwise; no_corner last for a triangle. A
+  /// corner is the first of the positions with its bits (welded): polygons
+  /// at one point share it even where the mesh repeats the point.
+  std::vector<std::uint32_t> corners;
   std::vector<float> inradius;         ///< per polygon, an upper bound (2 area / perimeter), object units, descending
   /// Per polygon, object space: the plane (unit normal of its counter-clockwise
   /// side, and offset: n·p = offset on it) and a sphere around its corners.
@@ -194,7 +197,7 @@ struct OccluderMesh {
   /// triangle's fourth. Rule 11 fuses the pairs.
   std::vector<std::uint32_t> neighbours;
   /// Whether its polygons share corners (at least 2 corners a vertex, as a
-  /// terrain's or a smooth mesh's do, not a flat-shaded box's): then each
+  /// terrain's or a box's do, welded, not a scatter of separate triangles'): then each
   /// vertex is transformed and projected once a call, not once a corner.
   bool shared_corners = false;
   [[nodiscard]] std::size_t polygons() const noexcept { return inradius.size(); }

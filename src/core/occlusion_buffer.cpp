@@ -265,8 +265,11 @@ OccluderMesh make_occluder_mesh(std::span<const glm::vec3> positions, std::span<
   OccluderMesh out;
   out.corners.reserve(polys.size() * 4);
   out.inradius.reserve(polys.size());
+  // Each corner by its welded vertex (the first of the positions with the
+  // same bits): a mesh that repeats a position for each polygon at it (flat
+  // shading, per-face attributes) transforms it once, as a shared one.
   for (const Poly& p : polys) {
-    out.corners.insert(out.corners.end(), p.c, p.c + 4);
+    for (const std::uint32_t c : p.c) out.corners.push_back(c == OccluderMesh::no_corner ? c : weld[c]);
     out.inradius.push_back(p.radius);
     out.bounds.push_back(p.bounds);
   }
