@@ -431,6 +431,21 @@ TEST(OcclusionBuffer, OccluderMeshPairsPolygonsAcrossManifoldEdgesOnly) {
   EXPECT_TRUE(pairs(quad.positions, quad.indices).empty());
 }
 
+// A point the mesh repeats (a fold of two triangles, each its own vertices,
+// as a flat-shaded mesh has) is one corner: the first of its positions, so
+// that the polygons at it share its transform.
+TEST(OcclusionBuffer, OccluderMeshCornersAtOnePointAreItsFirstVertex) {
+  const glm::vec3 e0 = at(5, 0, 5), e1 = at(5, 8, 5), left = at(1, 4, 5), right = at(9, 4, 7);
+  const std::vector<glm::vec3> positions{e0, e1, left, e1, e0, right};
+  const OccluderMesh mesh = make_occluder_mesh(positions, std::vector<std::uint32_t>{0, 1, 2, 3, 4, 5});
+  ASSERT_EQ(mesh.polygons(), 2u);
+  std::vector<std::uint32_t> used;
+  for (const std::uint32_t c : mesh.corners)
+    if (c != OccluderMesh::no_corner) used.push_back(c);
+  std::sort(used.begin(), used.end());
+  EXPECT_EQ(used, (std::vector<std::uint32_t>{0, 0, 1, 1, 2, 5}));
+}
+
 // The tiles' farthest depths only shortcut the texels' answer.
 TEST(OcclusionBuffer, TilesAnswerAsTexelsDo) {
   std::mt19937 rng(11);
