@@ -953,7 +953,10 @@ template <class PlaneOf>
     b.r = e.a * e.ox + e.b * (std::int64_t(y_lo) * kSub + e.oy) + e.c;
     b.dr = e.b * kSub;
     b.side = s > 0 ? 1 : s < 0 ? -1 : 0;
-    if (b.side == 0) continue;
+    if (b.side == 0) {  // only r matters; the rest is stepped as the others', harmlessly
+      b.q = b.rem = b.dq = b.drem = 0, b.d = 1;
+      continue;
+    }
     b.d = s > 0 ? s : -s;
     const std::int64_t n0 = s > 0 ? -b.r : b.r, dn = s > 0 ? -b.dr : b.dr;
     b.q = floor_div_bounded(n0, b.d);
@@ -988,7 +991,9 @@ template <class PlaneOf>
       b.r += b.dr;
       b.q += b.dq;
       b.rem += b.drem;
-      if (b.rem >= b.d) b.rem -= b.d, ++b.q;
+      const std::int64_t carry = b.rem >= b.d;  // no branch: which way it goes is a coin toss a row
+      b.rem -= b.d & -carry;
+      b.q += carry;
     }
     if (lo > hi) continue;
     if (!plane && !(plane = plane_of())) return;
