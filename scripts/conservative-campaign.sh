@@ -39,7 +39,7 @@ done
 kinds=(mixed tiny thin coplanar near far farout)
 paths=(walk graze far)
 modes=(samples any conservative)
-cullers="vfc,stopwait,chc,chc:cpu_test=on,chcpp,chcpp:virtual_leaf=0,chcpp:cpu_test=on,nohc,nohc:cpu_test=on,hiz,hiz:texels=2,soc,soc:scale=1:prepass=off,soc:scale=4:prepass=off:threads=1,auto"
+cullers="vfc,stopwait,chc,chc:cpu_test=on,chcpp,chcpp:virtual_leaf=0,chcpp:cpu_test=on,nohc,nohc:cpu_test=on,hiz,hiz:texels=2,soc,soc:scale=1:prepass=off,soc:scale=4:prepass=off:threads=1:rest=0,soc:rest=1:rest_triangles=0,auto"
 if [[ $short -eq 1 ]]; then objects=600; frames=12; else objects=3000; frames=30; fi
 
 RANDOM=$((seed % 32768))

@@ -104,7 +104,7 @@ TEST(Counters, EveryCounterAnAlgorithmReportsHasARowAndReachesTheFrame) {
   }
   // The algorithms' counters, each reported by some algorithm.
   for (const char* name : {"query_batches", "multiqueries", "failed_multiqueries", "raster_ms", "boxes_tested",
-                           "buffer_texels", "capped", "over_cap", "result_age", "revealed", "auto_choice",
+                           "buffer_texels", "occluders_resting", "capped", "over_cap", "result_age", "revealed", "auto_choice",
                            "auto_tries", "auto_switches", "tiles_rendered", "tile_queries", "tile_cache"})
     EXPECT_EQ(names.count(name), 1u) << name << " is reported by no algorithm";
 }

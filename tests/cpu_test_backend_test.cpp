@@ -317,6 +317,38 @@ TEST(Soc, APrepassedOccluderFoundHiddenAfterThePrepassIsNotDrawn) {
   EXPECT_EQ(frames, (std::vector<std::vector<ObjectId>>{{0, 1}, {0}}));
 }
 
+// soc:rest: an occluder that hides nothing for `rest` frames rests (is not
+// rasterized, but still drawn), tried again one frame in `rest`; one that
+// hides something does not. The wall hides the box behind it every frame; a
+// box in front of the wall, off to the side, hides nothing.
+TEST(Soc, AnOccluderThatHidesNothingRestsAndOneThatHidesDoesNot) {
+  const Scene scene = test::box_scene({{{-40, -40, -11}, {40, 40, -10}},  // 0: the wall
+                                       {{-1, -1, -30}, {1, 1, -28}},      // 1: behind it
+                                       {{3, -1, -6}, {4, 1, -5}}});       // 2: in front of it, aside
+  const Bvh bvh = Bvh::build(scene);
+  ScriptedBackend device;
+  auto soc = make_culler("soc:rest=2:rest_triangles=0", {scene, bvh});
+  std::vector<double> resting, triangles;
+  for (int frame = 0; frame < 12; ++frame) {
+    EXPECT_EQ(drawn_in_frame(*soc, camera(), device), (std::vector<ObjectId>{0, 2})) << "frame " << frame;
+    resting.push_back(test::counter(*soc, "occluders_resting"));
+    triangles.push_back(test::counter(*soc, "occluder_triangles"));
+  }
+  // On trial for its first frames, then resting but for a try now and then.
+  EXPECT_EQ(std::vector<double>(resting.begin(), resting.begin() + 4), (std::vector<double>{0, 0, 0, 1}));
+  EXPECT_EQ(*std::max_element(resting.begin(), resting.end()), 1.0);  // the aside box alone, never the wall
+  EXPECT_GE(std::count(resting.begin() + 3, resting.end(), 1.0), 6) << "it rests most frames";
+  EXPECT_NE(std::find(resting.begin() + 4, resting.end(), 0.0), resting.end()) << "and is tried again";
+  for (std::size_t f = 3; f < resting.size(); ++f)
+    if (resting[f] > 0.0) EXPECT_LT(triangles[f], triangles[0]) << "frame " << f;
+  // Off (the default): every occluder every frame.
+  auto plain = make_culler("soc", {scene, bvh});
+  for (int frame = 0; frame < 4; ++frame) {
+    EXPECT_EQ(drawn_in_frame(*plain, camera(), device), (std::vector<ObjectId>{0, 2}));
+    EXPECT_EQ(test::counter(*plain, "occluders_resting"), 0.0);
+  }
+}
+
 TEST(Soc, AnOccluderWithoutVerticesOnTheCpuHidesNothing) {
   Scene scene("info");
   const MaterialId mat = scene.add_material({"grey", {0.7f, 0.7f, 0.7f, 1.0f}, false, 0});

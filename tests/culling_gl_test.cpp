@@ -29,10 +29,10 @@ const char* const kConservative[] = {
     // chcpp, nohc, hiz: auto.cpp's hand-over) or back to their own stale state
     "auto:trial=1:period=2", "auto:candidates=soc+nohc+hiz+chcpp:trial=1:period=1",
     "hiz", "hiz:texels=2", "hiz:texels=16",
-    // soc: its defaults (a buffer about 320 texels across: one pixel a texel here, the prepass, two threads),
-    // the defaults before them, and other sizes and threads
-    "soc", "soc:scale=4:prepass=off:threads=1", "soc:scale=1:prepass=off:threads=3", "soc:width=64:height=36",
-    "soc:width=131:height=47", "soc:simd=off",
+    // soc: its defaults (a buffer about 320 texels across: one pixel a texel here, the prepass, two threads,
+    // occluders resting), the defaults before them, other sizes and threads, every occluder resting at once
+    "soc", "soc:scale=4:prepass=off:threads=1:rest=0", "soc:scale=1:prepass=off:threads=3", "soc:width=64:height=36",
+    "soc:width=131:height=47", "soc:simd=off", "soc:rest=1:rest_triangles=0",
     "chc:cpu_test=on", "chcpp:cpu_test=on", "chcpp:cpu_test=on:cpu_scale=1", "nohc:cpu_test=on",
     "chcpp:cpu_test=on:cpu_scale=1:cpu_threads=2"};
 

@@ -88,6 +88,7 @@ struct AlgorithmSummary {
   double occluder_triangles_per_frame = 0.0;  ///< triangles rasterized into the occlusion buffer (soc)
   double boxes_tested_per_frame = 0.0;    ///< boxes tested against the occlusion buffer (soc)
   double buffer_texels = 0.0;             ///< the occlusion buffer's texels (soc; median over frames)
+  double occluders_resting_per_frame = 0.0;  ///< occluders left out for hiding nothing lately (soc's rest)
   double model_ms_per_frame = 0.0;        ///< cost-model prediction (0 without --model)
   double auto_tries = 0.0;                ///< auto: tries of a challenger over the run (FrameStats::auto_tries)
   double auto_switches = 0.0;             ///< auto: changes of the culler kept over the run

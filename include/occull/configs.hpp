@@ -128,6 +128,21 @@ struct OccluderChoice {
   /// Polygons whose inscribed circle is below 1/detail of their mesh's
   /// largest are left out; in [0, 1e6], 0: none.
   double detail = 8.0;
+  /// Frames an occluder goes on being rasterized while hiding nothing; in
+  /// [0, 1e6], 0: off (every occluder every frame). Past that it rests:
+  /// rasterized one frame in `rest` (staggered by object; one in 2, 4, then
+  /// 8 × `rest` as it goes on hiding nothing), back for `rest` frames
+  /// whenever a box found hidden reads a texel whose key it wrote
+  /// (OcclusionBuffer::track_sources), and when it comes back into view
+  /// (met as an occluder this frame, not the last). Any choice of occluders is
+  /// conservative: a resting one is still drawn when visible, it only hides
+  /// nothing on the CPU. Only `soc` learns this (4 there: SocConfig; the
+  /// query cullers' CPU test leaves it 0).
+  int rest = 0;
+  /// With rest: occluders of fewer triangles never rest; in [0, 2^30]. They
+  /// cost little to rasterize, and one resting when it could hide something
+  /// costs the draws it would have saved until its next try.
+  int rest_triangles = 64;
 };
 
 /// Software occlusion culling: a strictly conservative CPU occlusion buffer,
@@ -141,7 +156,9 @@ struct SocConfig {
   static constexpr int auto_width = 320;
   int width = 0;   ///< explicit buffer width in texels; in [0, 8192], 0: from scale
   int height = 0;  ///< explicit buffer height in texels; in [0, 8192], 0: from scale
-  OccluderChoice occluders;
+  /// Which objects occlude; soc's own default rests occluders that hide
+  /// nothing (rest = 4: field/glide's CPU 5.9 -> 3.7 ms, docs/performance.md).
+  OccluderChoice occluders{.rest = 4};
   bool simd = true;  ///< vectorised inner loops (off: the scalar reference, equal bit for bit)
   bool fuse = true;  ///< fused pairs (OcclusionBuffer rule 11): polygons sharing an edge cover the seam between them
   /// Threads rasterizing the prepass and an occluder of many polygons

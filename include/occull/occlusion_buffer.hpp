@@ -293,7 +293,8 @@ class OcclusionBuffer {
     std::span<const glm::vec3> positions;
     const OccluderMesh* mesh;  ///< made from positions; not null
     glm::mat4 object_to_world;
-    Aabb bounds;  ///< world space
+    Aabb bounds;               ///< world space
+    std::uint32_t source = 0;  ///< the tag its texels keep (track_sources), as set_source sets for a single call
   };
   /// Rasterizes each of `draws` as rasterize(positions, *mesh, view,
   /// object_to_world, bounds) does, the draws shared among the buffer's
@@ -321,6 +322,32 @@ class OcclusionBuffer {
   [[nodiscard]] std::span<const float> keys() const noexcept { return keys_; }
   /// Texel (x, y)'s key.
   [[nodiscard]] float key_at(int x, int y) const { return keys_.at(std::size_t(y) * std::size_t(width_) + std::size_t(x)); }
+
+  /// Sources: which occluder wrote each texel's key, for a caller that
+  /// learns which occluders hide anything (soc's `rest`). Off by default
+  /// (no cost); on, every texel also keeps the tag of the polygon its key
+  /// came from, the smallest tag among those that wrote that same nearest
+  /// key: like the keys, the same in any order and on any threads. The keys
+  /// are the same bit for bit on or off. Switching it on empties the tags
+  /// (no_source) until the next clear.
+  void track_sources(bool on);
+  [[nodiscard]] bool tracks_sources() const noexcept { return !sources_.empty(); }
+  static constexpr std::uint32_t no_source = 0xffffffffu;  ///< the tag of a texel nothing was rasterized into
+  /// The tag the texels written by the single-call rasterize functions keep
+  /// from now on (the batch call takes each draw's OccluderDraw::source).
+  void set_source(std::uint32_t tag) noexcept { source_ = tag; }
+  /// With track_sources: appends to `out` the tags of the texels whose keys
+  /// occluded(box, view_proj) compares the box against, each run of equal
+  /// tags once (a tag may still appear more than once; no_source left out).
+  /// Appends nothing where occluded() would decide without texels (a box
+  /// off the buffer, reaching the eye, holding no pixel centre) or without
+  /// track_sources. Credit, not proof: call it for a box occluded() found
+  /// hidden, and every tag it appends hid part of it.
+  void sources_under(const Aabb& box, const glm::mat4& view_proj, std::vector<std::uint32_t>& out) const;
+  /// Texel (x, y)'s tag (no_source without track_sources).
+  [[nodiscard]] std::uint32_t source_at(int x, int y) const {
+    return sources_.empty() ? no_source : sources_.at(std::size_t(y) * std::size_t(width_) + std::size_t(x));
+  }
   /// Texels with something rasterized.
   [[nodiscard]] std::size_t covered_texels() const noexcept;
 
@@ -346,8 +373,11 @@ class OcclusionBuffer {
   struct Lane {
     float* keys = nullptr;
     std::uint8_t* dirty = nullptr;
+    std::uint32_t* sources = nullptr;     // null without track_sources
+    std::uint32_t source = 0;             // the tag of what is rasterized now
     std::vector<float> own_keys;          // lanes past 0
     std::vector<std::uint8_t> own_dirty;  // lanes past 0
+    std::vector<std::uint32_t> own_sources;  // lanes past 0, with track_sources
     std::vector<ClipVertex> vertices;
     std::vector<std::uint32_t> vertex_stamp;
     std::uint32_t stamp = 0;
@@ -403,6 +433,11 @@ class OcclusionBuffer {
   template <class PlaneOf>  // PlaneOf: () -> const DepthPlane* (null: no plane)
   void fill_region(Lane& lane, const Edge* edges, int edge_count, const TexelRect& r, PlaneOf&& plane_of) const;
   float tile_farthest(int tx, int ty);
+  /// What occluded() compares a box against: the texels `rect` (clamped to
+  /// the buffer) and the box's nearest key, or a decision made without
+  /// texels.
+  enum class BoxReach { visible, hidden, texels };
+  BoxReach box_reach(const Aabb& box, const glm::mat4& view_proj, TexelRect& rect, float& nearest) const;
   /// Half the side of what a texel must have inside a polygon to be covered
   /// (the texel, or with rule 10 its pixel centres' square), in texels.
   [[nodiscard]] double covered_half_side() const noexcept;
@@ -417,6 +452,8 @@ class OcclusionBuffer {
   bool fused_pairs_ = true;   // rule 11
   std::int64_t inset_ = 0;    // rule 10: fixed-point steps from a texel's side to its centres' square
   std::vector<float> keys_;
+  std::vector<std::uint32_t> sources_;  // per texel with track_sources, else empty
+  std::uint32_t source_ = 0;            // set_source
   std::vector<float> tile_far_;
   std::vector<std::uint8_t> tile_dirty_;
   std::vector<Lane> lanes_;                 // one a thread; lanes_[0] the caller's

@@ -47,6 +47,7 @@ struct FrameStats {
   std::uint64_t occluder_triangles = 0;  ///< triangles rasterized into the buffer (after clipping, front faces)
   std::uint64_t boxes_tested = 0;        ///< node and object boxes tested against the buffer
   std::uint64_t buffer_texels = 0;       ///< the buffer's width × height
+  std::uint64_t occluders_resting = 0;   ///< occluders left out for hiding nothing lately (soc's rest)
 
   // The adaptive culler (auto): which candidate ran, and its decisions.
   std::uint32_t auto_choice = 0;   ///< 1 + index in Culler::choices() of the candidate auto ran this frame; 0: not auto

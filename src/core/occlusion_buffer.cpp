@@ -39,6 +39,20 @@ constexpr double kGrowTexels = double(kGrow) / double(kSub);
   }
 }
 
+// fill_span_scalar keeping each texel's tag (track_sources): a nearer key
+// takes `tag`, the same key the smaller tag, so the tags do not depend on the
+// order of the writes. The keys as fill_span_scalar writes them.
+[[gnu::optimize("no-tree-vectorize")]] void fill_span_sourced_scalar(float* row, std::uint32_t* sources, int count,
+                                                                    float base, float step, float cap,
+                                                                    std::uint32_t tag) {
+  for (int i = 0; i < count; ++i) {
+    const float v = base + step * float(i);
+    const float depth = v < cap ? v : cap;
+    if (depth < row[i] || (depth == row[i] && tag < sources[i])) sources[i] = tag;
+    row[i] = row[i] < depth ? row[i] : depth;
+  }
+}
+
 [[gnu::optimize("no-tree-vectorize")]] float max_span_scalar(const float* row, int count) {
   float best = -kInf;
   for (int i = 0; i < count; ++i) best = best > row[i] ? best : row[i];
@@ -334,6 +348,7 @@ void OcclusionBuffer::set_threads(int threads) {
   for (std::size_t i = 1; i < lanes_.size(); ++i) {
     lanes_[i].own_keys.assign(keys_.size(), kInf);
     lanes_[i].own_dirty.assign(tile_dirty_.size(), 0);
+    lanes_[i].own_sources.assign(sources_.size(), no_source);
   }
   if (threads > 1) pool_ = std::make_unique<detail::WorkerPool>(threads - 1);
 }
@@ -351,6 +366,14 @@ void OcclusionBuffer::merge(Lane& lane) {
         const std::size_t i = std::size_t(y) * std::size_t(width_) + std::size_t(x0);
         float* to = keys_.data() + i;
         float* from = lane.own_keys.data() + i;
+        if (!sources_.empty()) {  // as fill_span_sourced keeps the tags
+          std::uint32_t* to_tag = sources_.data() + i;
+          std::uint32_t* from_tag = lane.own_sources.data() + i;
+          for (int x = 0; x < w; ++x) {
+            if (from[x] < to[x] || (from[x] == to[x] && from_tag[x] < to_tag[x])) to_tag[x] = from_tag[x];
+            from_tag[x] = no_source;
+          }
+        }
         for (int x = 0; x < w; ++x) {
           to[x] = to[x] < from[x] ? to[x] : from[x];  // as fill_span keeps the nearer
           from[x] = kInf;
@@ -364,6 +387,7 @@ void OcclusionBuffer::clear(const ClipSpace& clip) {
   pixels_ = 0;
   inset_ = 0;
   std::fill(keys_.begin(), keys_.end(), kInf);
+  std::fill(sources_.begin(), sources_.end(), no_source);
   std::fill(tile_far_.begin(), tile_far_.end(), kInf);
   std::fill(tile_dirty_.begin(), tile_dirty_.end(), std::uint8_t{0});
 }
@@ -379,6 +403,20 @@ void OcclusionBuffer::clear(const View& view) {
     // Half a pixel in from each side, rounded down to a fixed-point step (a
     // smaller square: more conservative).
     inset_ = kSub / (2 * std::int64_t(pixels_));
+  }
+}
+
+void OcclusionBuffer::track_sources(bool on) {
+  if (on == tracks_sources()) return;
+  if (on)
+    sources_.assign(keys_.size(), no_source);
+  else
+    sources_ = {};
+  for (std::size_t i = 1; i < lanes_.size(); ++i) {
+    if (on)
+      lanes_[i].own_sources.assign(keys_.size(), no_source);
+    else
+      lanes_[i].own_sources = {};
   }
 }
 
@@ -431,6 +469,7 @@ std::uint32_t OcclusionBuffer::rasterize(std::span<const OccluderDraw> draws, co
     for (std::size_t d = next.fetch_add(1, std::memory_order_relaxed); d < draws.size();
          d = next.fetch_add(1, std::memory_order_relaxed)) {
       const OccluderDraw& draw = draws[d];
+      lane.source = draw.source;
       const std::size_t count = choose_polygons(lane.chosen, *draw.mesh, view, draw.object_to_world, draw.bounds);
       if (count == 0) continue;
       const glm::dmat4 object_to_clip = glm::dmat4(view.view_proj) * glm::dmat4(draw.object_to_world);
@@ -536,6 +575,8 @@ void OcclusionBuffer::start_lanes(std::size_t lanes) {
     Lane& lane = lanes_[l];
     lane.keys = l == 0 ? keys_.data() : lane.own_keys.data();
     lane.dirty = l == 0 ? tile_dirty_.data() : lane.own_dirty.data();
+    lane.sources = sources_.empty() ? nullptr : l == 0 ? sources_.data() : lane.own_sources.data();
+    lane.source = source_;
     lane.count = 0;
   }
 }
@@ -1001,9 +1042,14 @@ template <class PlaneOf>
                           plane->gy * (double(ty) + plane->fy - plane->p0.y) + plane->bias;
     float base = float(base_d);
     if (double(base) < base_d) base = next_up(base);
-    float* row = lane.keys + std::size_t(ty) * std::size_t(width_) + std::size_t(lo);
+    const std::size_t at = std::size_t(ty) * std::size_t(width_) + std::size_t(lo);
+    float* row = lane.keys + at;
     const int span = int(hi - lo + 1);
-    if (simd_ == SimdPath::best && span >= kShortSpan)
+    if (lane.sources && simd_ == SimdPath::best && span >= kShortSpan)
+      simd::fill_span_sourced(row, lane.sources + at, span, base, float(plane->gx), plane->cap, lane.source);
+    else if (lane.sources)
+      fill_span_sourced_scalar(row, lane.sources + at, span, base, float(plane->gx), plane->cap, lane.source);
+    else if (simd_ == SimdPath::best && span >= kShortSpan)
       simd::fill_span(row, span, base, float(plane->gx), plane->cap);
     else  // a short span here, as the vector code fills its tail: no dispatch through a pointer
       fill_span_scalar(row, span, base, float(plane->gx), plane->cap);
@@ -1043,13 +1089,14 @@ float OcclusionBuffer::tile_farthest(int tx, int ty) {
   return tile_far_[t];
 }
 
-bool OcclusionBuffer::occluded(const Aabb& box, const glm::mat4& view_proj) {
-  if (box.empty()) return false;
+OcclusionBuffer::BoxReach OcclusionBuffer::box_reach(const Aabb& box, const glm::mat4& view_proj, TexelRect& rect,
+                                                      float& nearest) const {
+  if (box.empty()) return BoxReach::visible;
   const BoxFootprint f = project_box(box, view_proj, clip_, width_, height_);
-  if (f.reaches_eye && rules_.reaching_eye_visible) return false;  // rule 7
-  if (f.projected == 0) return false;
+  if (f.reaches_eye && rules_.reaching_eye_visible) return BoxReach::visible;  // rule 7
+  if (f.projected == 0) return BoxReach::visible;
   // Rule 6: the nearest corner, as a key.
-  float nearest = clip_.reversed_z ? -f.max_depth : f.min_depth;
+  nearest = clip_.reversed_z ? -f.max_depth : f.min_depth;
   if (!rules_.nearest_corner) {  // broken: the centre's depth
     const float depth = window_depth(box.center(), view_proj, clip_);
     nearest = clip_.reversed_z ? -depth : depth;
@@ -1067,18 +1114,38 @@ bool OcclusionBuffer::occluded(const Aabb& box, const glm::mat4& view_proj) {
     const auto first = [&](float v, int size) { return int(std::clamp(std::ceil(v - 1.0f + in), -1.0f, float(size))); };
     x0 = first(min_x - grow, width_), x1 = last(max_x + grow, width_);
     y0 = first(min_y - grow, height_), y1 = last(max_y + grow, height_);
-    if (x0 > x1 || y0 > y1) return false;  // holds no pixel centre: not the buffer's to say (holds_no_sample)
+    if (x0 > x1 || y0 > y1) return BoxReach::visible;  // holds no pixel centre: not the buffer's to say (holds_no_sample)
   } else if (rules_.outer_rectangle) {
     x0 = texel(min_x - grow, width_), x1 = texel(max_x + grow, width_);
     y0 = texel(min_y - grow, height_), y1 = texel(max_y + grow, height_);
   } else {  // texels whose centre lies in the rectangle (rule 5 broken)
     x0 = texel(std::ceil(min_x - 0.5f), width_), x1 = texel(max_x - 0.5f, width_);
     y0 = texel(std::ceil(min_y - 0.5f), height_), y1 = texel(max_y - 0.5f, height_);
-    if (x0 > x1 || y0 > y1) return true;  // no texel: nothing tested, nothing found visible
+    if (x0 > x1 || y0 > y1) return BoxReach::hidden;  // no texel: nothing tested, nothing found visible
   }
-  if (x1 < 0 || y1 < 0 || x0 >= width_ || y0 >= height_) return false;  // off the buffer: the caller's frustum decides
-  x0 = std::max(x0, 0), y0 = std::max(y0, 0);
-  x1 = std::min(x1, width_ - 1), y1 = std::min(y1, height_ - 1);
+  if (x1 < 0 || y1 < 0 || x0 >= width_ || y0 >= height_) return BoxReach::visible;  // off the buffer: the caller's frustum decides
+  rect = {std::max(x0, 0), std::min(x1, width_ - 1), std::max(y0, 0), std::min(y1, height_ - 1)};
+  return BoxReach::texels;
+}
+
+void OcclusionBuffer::sources_under(const Aabb& box, const glm::mat4& view_proj, std::vector<std::uint32_t>& out) const {
+  TexelRect r{};
+  float nearest = 0.0f;
+  if (sources_.empty() || box_reach(box, view_proj, r, nearest) != BoxReach::texels) return;
+  std::uint32_t last = no_source;
+  for (int y = r.y_lo; y <= r.y_hi; ++y) {
+    const std::uint32_t* row = sources_.data() + std::size_t(y) * std::size_t(width_);
+    for (int x = r.x_lo; x <= r.x_hi; ++x)
+      if (row[x] != last && row[x] != no_source) out.push_back(last = row[x]);
+  }
+}
+
+bool OcclusionBuffer::occluded(const Aabb& box, const glm::mat4& view_proj) {
+  TexelRect r{};
+  float nearest = 0.0f;
+  const BoxReach reach = box_reach(box, view_proj, r, nearest);
+  if (reach != BoxReach::texels) return reach == BoxReach::hidden;
+  const int x0 = r.x_lo, x1 = r.x_hi, y0 = r.y_lo, y1 = r.y_hi;
   const bool margin = rules_.depth_margin;
   for (int ty = y0 / tile_size; ty <= y1 / tile_size; ++ty)
     for (int tx = x0 / tile_size; tx <= x1 / tile_size; ++tx) {

@@ -35,6 +35,36 @@ void FillSpan(float* HWY_RESTRICT row, int count, float base, float step, float 
   }
 }
 
+// FillSpan keeping each texel's tag: where the new depth is nearer, `tag`;
+// where it equals the key, the smaller of the two tags.
+void FillSpanSourced(float* HWY_RESTRICT row, std::uint32_t* HWY_RESTRICT sources, int count, float base, float step,
+                     float cap, std::uint32_t tag) {
+  const hn::ScalableTag<float> d;
+  const hn::RebindToUnsigned<decltype(d)> du;
+  const int lanes = int(hn::Lanes(d));
+  const auto vbase = hn::Set(d, base), vstep = hn::Set(d, step), vcap = hn::Set(d, cap);
+  const auto vtag = hn::Set(du, tag);
+  auto index = hn::Iota(d, 0.0f);
+  const auto advance = hn::Set(d, float(lanes));
+  int i = 0;
+  for (; i + lanes <= count; i += lanes) {
+    const auto depth = hn::Min(hn::Add(vbase, hn::Mul(vstep, index)), vcap);
+    const auto old = hn::LoadU(d, row + i);
+    const auto src = hn::LoadU(du, sources + i);
+    const auto take = hn::Or(hn::RebindMask(du, hn::Lt(depth, old)),
+                             hn::And(hn::RebindMask(du, hn::Eq(depth, old)), hn::Lt(vtag, src)));
+    hn::StoreU(hn::Min(old, depth), d, row + i);
+    hn::StoreU(hn::IfThenElse(take, vtag, src), du, sources + i);
+    index = hn::Add(index, advance);
+  }
+  for (; i < count; ++i) {  // the tail, as the reference does it
+    const float v = base + step * float(i);
+    const float depth = v < cap ? v : cap;
+    if (depth < row[i] || (depth == row[i] && tag < sources[i])) sources[i] = tag;
+    row[i] = row[i] < depth ? row[i] : depth;
+  }
+}
+
 // The largest of row[0, count); -infinity when count is 0.
 float MaxSpan(const float* HWY_RESTRICT row, int count) {
   const hn::ScalableTag<float> d;
@@ -60,10 +90,15 @@ namespace occull::simd {
 
 HWY_EXPORT(FillSpan);
 HWY_EXPORT(MaxSpan);
+HWY_EXPORT(FillSpanSourced);
 HWY_EXPORT(Target);
 
 void fill_span(float* row, int count, float base, float step, float cap) {
   HWY_DYNAMIC_DISPATCH(FillSpan)(row, count, base, step, cap);
+}
+void fill_span_sourced(float* row, std::uint32_t* sources, int count, float base, float step, float cap,
+                       std::uint32_t tag) {
+  HWY_DYNAMIC_DISPATCH(FillSpanSourced)(row, sources, count, base, step, cap, tag);
 }
 float max_span(const float* row, int count) { return HWY_DYNAMIC_DISPATCH(MaxSpan)(row, count); }
 std::string target_name() { return hwy::TargetName(HWY_DYNAMIC_DISPATCH(Target)()); }

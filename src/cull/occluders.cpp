@@ -1,5 +1,8 @@
 #include "occluders.hpp"
 
+#include "occull/error.hpp"
+
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 
@@ -14,6 +17,53 @@ void Occluders::begin_frame(const View& view, const OcclusionBuffer& buffer) {
   // Texels per scene unit of radius at unit distance (orthographic: at any distance).
   texel_scale_ = std::abs(double(view.proj[1][1])) * 0.5 * double(buffer.height());
   sometimes_left_ = std::uint64_t(choice_.budget);
+  resting_ = 0;
+  if (!learns()) return;
+  if (!buffer.tracks_sources()) throw UsageError("Occluders: rest needs a buffer that tracks sources");
+  if (++frame_ == 0) {  // wrapped: every occluder starts afresh
+    std::fill(useful_.begin(), useful_.end(), 0u);
+    std::fill(met_.begin(), met_.end(), 0u);
+    frame_ = 2;
+  }
+  useful_.resize(scene_.objects().size(), 0);
+  met_.resize(scene_.objects().size(), 0);
+}
+
+bool Occluders::learns() {
+  if (choice_.rest == 0) return false;
+  const std::span<const Object> objects = scene_.objects();
+  for (; restable_checked_ < objects.size() && !restable_; ++restable_checked_) {
+    const Object& o = objects[restable_checked_];
+    restable_ = o.occluder != OccluderClass::never && o.triangles >= std::uint64_t(choice_.rest_triangles);
+  }
+  return restable_;
+}
+
+bool Occluders::rests(ObjectId id) {
+  if (!restable_) return false;
+  std::uint32_t& useful = useful_[id];
+  // Met twice a frame: by soc's prepass, resting, then by its walk.
+  const bool again = met_[id] == frame_;
+  if (!again && met_[id] + 1 != frame_) useful = frame_;  // back in view, or new: a fresh trial
+  met_[id] = frame_;
+  const auto rest = std::uint32_t(choice_.rest);
+  const std::uint32_t idle = frame_ - useful;
+  if (idle <= rest) return false;
+  if (scene_.object(id).triangles < std::uint64_t(choice_.rest_triangles)) return false;
+  // Tried again one frame in `period`: `rest`, doubled while it finds nothing, up to 8 × rest.
+  std::uint32_t period = rest;
+  while (period < 8 * rest && idle >= 2 * period) period *= 2;
+  if ((frame_ + id) % period == 0) return false;
+  if (!again) ++resting_;
+  return true;
+}
+
+void Occluders::credit(const OcclusionBuffer& buffer, const Aabb& box, const glm::mat4& view_proj) {
+  if (!restable_) return;
+  tags_.clear();
+  buffer.sources_under(box, view_proj, tags_);
+  for (const std::uint32_t tag : tags_)
+    if (tag < useful_.size()) useful_[tag] = frame_;
 }
 
 std::optional<OcclusionBuffer::OccluderDraw> Occluders::occluder_draw(ObjectId id, const Aabb& bounds,
@@ -27,11 +77,12 @@ std::optional<OcclusionBuffer::OccluderDraw> Occluders::occluder_draw(ObjectId i
   if (o.removed || o.occluder == OccluderClass::never || scene_.material(o.material).translucent) return std::nullopt;
   const Mesh& mesh = scene_.mesh(o.mesh);
   if (mesh.positions.empty()) return std::nullopt;  // the engine keeps its vertices: nothing to rasterize
+  if (rests(id)) return std::nullopt;
   if (o.occluder == OccluderClass::sometimes) {
     if (o.triangles > sometimes_left_) return std::nullopt;
     sometimes_left_ -= o.triangles;
   }
-  return OcclusionBuffer::OccluderDraw{mesh.positions, &occluder_of(o.mesh), o.transform, o.bounds};
+  return OcclusionBuffer::OccluderDraw{mesh.positions, &occluder_of(o.mesh), o.transform, o.bounds, id};
 }
 
 bool Occluders::rasterize_if_occluder(OcclusionBuffer& buffer, ObjectId id, const Aabb& bounds, const View& view,
@@ -39,6 +90,7 @@ bool Occluders::rasterize_if_occluder(OcclusionBuffer& buffer, ObjectId id, cons
   const std::optional<OcclusionBuffer::OccluderDraw> draw = occluder_draw(id, bounds, view);
   if (!draw) return false;
   const auto start = std::chrono::steady_clock::now();
+  buffer.set_source(draw->source);
   counters.occluder_triangles += buffer.rasterize(draw->positions, *draw->mesh, view, draw->object_to_world, draw->bounds);
   counters.raster_ms += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   return true;

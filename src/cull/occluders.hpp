@@ -20,6 +20,7 @@ struct BufferCounters {
   std::uint64_t occluder_triangles = 0;  ///< triangles rasterized (after clipping, front faces)
   std::uint64_t boxes_tested = 0;        ///< node and object boxes tested
   std::uint64_t buffer_texels = 0;       ///< the buffer's width × height
+  std::uint64_t occluders_resting = 0;   ///< occluders not rasterized for hiding nothing lately (soc's rest)
 
   void visit(const CounterVisitor& visit) const {
     visit("raster_ms", raster_ms);
@@ -27,6 +28,7 @@ struct BufferCounters {
     visit("occluder_triangles", double(occluder_triangles));
     visit("boxes_tested", double(boxes_tested));
     visit("buffer_texels", double(buffer_texels));
+    visit("occluders_resting", double(occluders_resting));
   }
 };
 
@@ -46,8 +48,20 @@ inline constexpr std::uint64_t kTestsPerTimedTest = 8;
 class Occluders {
  public:
   Occluders(const Scene& scene, const OccluderChoice& choice);
+  /// Whether occluders may rest (OccluderChoice::rest): rest is on and some
+  /// occluder has rest_triangles or more. The buffer must then track
+  /// sources (OcclusionBuffer::track_sources) before begin_frame; otherwise
+  /// it need not (no cost).
+  [[nodiscard]] bool learns();
   /// Starts a frame on `buffer` (already cleared) seen through `view`.
+  /// Throws UsageError where learns() and the buffer does not track sources.
   void begin_frame(const View& view, const OcclusionBuffer& buffer);
+  /// With OccluderChoice::rest: `box` was found hidden in `buffer`; the
+  /// occluders whose texels it was compared against hid something this
+  /// frame and are not resting for `rest` frames. Without rest: nothing.
+  void credit(const OcclusionBuffer& buffer, const Aabb& box, const glm::mat4& view_proj);
+  /// Occluders resting this frame (OccluderChoice::rest), so far.
+  [[nodiscard]] std::uint64_t resting() const noexcept { return resting_; }
   /// Rasterizes object `id` if it is an occluder; adds the time and
   /// polygons to counters.raster_ms and counters.occluder_triangles.
   /// Returns whether it was. The caller guarantees the object is drawn in
@@ -73,12 +87,22 @@ class Occluders {
 
  private:
   const OccluderMesh& occluder_of(MeshId mesh);
+  /// Whether occluder `id` rests this frame (OccluderChoice::rest); its first
+  /// frame as an occluder starts its `rest` frames.
+  bool rests(ObjectId id);
 
   const Scene& scene_;
   OccluderChoice choice_;
   std::vector<std::optional<OccluderMesh>> meshes_;  // per mesh, made when first needed
   double texel_scale_ = 1.0;
   std::uint64_t sometimes_left_ = 0;
+  std::uint32_t frame_ = 1;            // frames begun, plus 1, for rest (no object met in frame 1 - 1)
+  std::vector<std::uint32_t> useful_;  // per object, with rest: the last frame it hid something, or came into view
+  std::vector<std::uint32_t> met_;     // per object, with rest: the last frame it was met as an occluder (0: never)
+  std::vector<std::uint32_t> tags_;    // sources_under's (scratch)
+  std::uint64_t resting_ = 0;          // this frame
+  bool restable_ = false;              // learns(): some occluder of the objects checked may rest
+  std::size_t restable_checked_ = 0;   // objects checked for restable_ so far
 };
 
 }  // namespace occull::detail

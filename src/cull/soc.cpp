@@ -15,7 +15,12 @@
 // rasterized (OcclusionBuffer::rasterize): skipping one never hides
 // anything. Everything rasterized is drawn in the same frame (it passed its
 // own test first), so a box the buffer hides is hidden on screen: the
-// culler is conservative exactly when the buffer is.
+// culler is conservative exactly when the buffer is. Which occluders are
+// rasterized changes what is hidden, never whether the culler is
+// conservative: an occluder of many polygons that has hidden nothing for
+// `rest` frames rests (not rasterized, still drawn), tried again now and
+// then; the buffer tags each texel with the occluder that wrote it, and a
+// box found hidden credits the tags under it (Occluders::credit).
 // An interior node that held a drawn object in the last frame is not
 // tested, against the buffer nor for holding a pixel centre: it is most
 // likely visible again, and its children are tested. A
@@ -96,7 +101,7 @@ class SocCuller final : public Culler {
       }
       occluders_.rasterize(buffer, draws_, view, counters);
       for (const ObjectId id : prepassed_)
-        if (!test_box(buffer, index_.scene.object(id).bounds, view.view_proj, counters)) {
+        if (!hidden(buffer, index_.scene.object(id).bounds, view, counters)) {
           queue_.push_back(id);
           queued_[id] = frame_;
         }
@@ -109,7 +114,7 @@ class SocCuller final : public Culler {
       ++result.nodes_visited;
       const bool shown_last_frame = !bvh.is_leaf(n) && shown_[n] + 1 == frame_;
       if (bvh.node(n).object_count == 0 || frustum_.outside(bvh, n, !shown_last_frame)) continue;
-      if (n != Bvh::root() && !shown_last_frame && test_box(buffer, bvh.node(n).bounds, view.view_proj, counters))
+      if (n != Bvh::root() && !shown_last_frame && hidden(buffer, bvh.node(n).bounds, view, counters))
         continue;
       if (!bvh.is_leaf(n)) {
         open.push(bvh, Bvh::left(n), view.eye);
@@ -122,7 +127,7 @@ class SocCuller final : public Culler {
       const bool tested = leaf_.size() == 1 && bvh.node(n).object_count == 1 && n != Bvh::root();
       for (ObjectId id : leaf_) {
         const Aabb& box = tested ? bvh.node(n).bounds : index_.scene.object(id).bounds;
-        if (!tested && test_box(buffer, box, view.view_proj, counters)) continue;
+        if (!tested && hidden(buffer, box, view, counters)) continue;
         if (prerasterized_[id] == frame_) {
           // Rasterized by the prepass; in the next prepass only if found visible again. (Found hidden after the
           // prepass, it cannot be visible now: drawing it anyway is safe.)
@@ -135,12 +140,20 @@ class SocCuller final : public Culler {
         for (NodeId m = n; m != kNoNode && shown_[m] != frame_; m = bvh.node(m).parent) shown_[m] = frame_;
       }
     }
+    counters.occluders_resting = occluders_.resting();
     if (!queue_.empty()) backend.render(queue_);
     return result;
   }
   [[nodiscard]] const OcclusionBuffer* occlusion_buffer() const override { return buffer_ ? &*buffer_ : nullptr; }
 
  private:
+  /// test_box, and a box found hidden credits the occluders that hid it (rest).
+  bool hidden(OcclusionBuffer& buffer, const Aabb& box, const View& view, BufferCounters& counters) {
+    if (!test_box(buffer, box, view.view_proj, counters)) return false;
+    occluders_.credit(buffer, box, view.view_proj);
+    return true;
+  }
+
   OcclusionBuffer& buffer_for(const View& view) {
     const int scale = config_.scale > 0 ? config_.scale : std::max(1, view.width / SocConfig::auto_width);
     const int w = config_.width > 0 ? config_.width : std::max(1, view.width / scale);
@@ -149,6 +162,7 @@ class SocCuller final : public Culler {
     if (!buffer_ || buffer_->width() != w || buffer_->height() != h) buffer_.emplace(w, h, simd);
     buffer_->set_fused_pairs(config_.fuse);
     buffer_->set_threads(threads_);
+    buffer_->track_sources(occluders_.learns());
     return *buffer_;
   }
 
@@ -187,6 +201,12 @@ Registration soc_registration() {
           .real("detail", [](auto& c) -> auto& { return c.occluders.detail; }, 0.0, 1e6,
                 "an occluder's polygons whose inscribed circle is below 1/detail of its largest are not rasterized "
                 "(0: all)")
+          .integer("rest", [](auto& c) -> auto& { return c.occluders.rest; }, 0, 1000000,
+                   "frames an occluder that hides nothing goes on being rasterized; then it rests, rasterized one "
+                   "frame in `rest` (then in 2, 4, 8 times `rest`) until a box it hides is found (0: every occluder "
+                   "every frame)")
+          .integer("rest_triangles", [](auto& c) -> auto& { return c.occluders.rest_triangles; }, 0, 1 << 30,
+                   "with rest: occluders of fewer triangles never rest (cheap to rasterize)")
           .integer("threads", &SocConfig::threads, 0, OcclusionBuffer::max_threads,
                    "threads rasterizing the prepass and an occluder of many polygons (the caller's and the buffer's "
                    "own; the buffer is the same whatever the threads; 0: two, one on a one-thread machine)")

@@ -43,6 +43,9 @@ constexpr std::array kCounters = std::to_array<Counter>({
      &S::boxes_tested_per_frame, -1, false, "count", "node and object boxes tested against the occlusion buffer (soc)"},
     {"buffer_texels", &F::buffer_texels, none, C::max, C::mean, C::median, "buffer_texels", &S::buffer_texels, -1,
      false, "count", "the occlusion buffer's width × height (soc)"},
+    {"occluders_resting", &F::occluders_resting, none, C::sum, C::mean, C::median, "occluders_resting_per_frame",
+     &S::occluders_resting_per_frame, -1, false, "count",
+     "occluders not rasterized because they hid nothing lately (soc's rest option)"},
     {"auto_choice", &F::auto_choice, none, C::max, C::none, C::none, "", none, -1, false, "index",
      "auto: 1 + the index of the candidate it ran (results.json's auto_choices name them in order); 0 for the "
      "other cullers"},
