@@ -314,8 +314,14 @@ class OcclusionBuffer {
   /// through `view_proj` (the same view). False means "may be visible".
   /// An empty box, or one whose rectangle lies off the buffer, is visible
   /// (the caller's frustum test decides those). Not const: refreshes the
-  /// farthest key of tiles written since they were last read.
-  [[nodiscard]] bool occluded(const Aabb& box, const glm::mat4& view_proj);
+  /// farthest key of tiles written since they were last read. With
+  /// track_sources and `sources`, a box found hidden appends to `sources`
+  /// the tags of the texels it was compared against, each run of equal tags
+  /// once (a tag may still appear more than once; no_source left out): each
+  /// of them hid part of it. Nothing is appended for a box decided without
+  /// texels, or found visible.
+  [[nodiscard]] bool occluded(const Aabb& box, const glm::mat4& view_proj,
+                              std::vector<std::uint32_t>* sources = nullptr);
 
   /// The texels' keys (window depth, negated with reversed-Z; +infinity
   /// where nothing is rasterized), row-major, bottom row first.
@@ -324,7 +330,8 @@ class OcclusionBuffer {
   [[nodiscard]] float key_at(int x, int y) const { return keys_.at(std::size_t(y) * std::size_t(width_) + std::size_t(x)); }
 
   /// Sources: which occluder wrote each texel's key, for a caller that
-  /// learns which occluders hide anything (soc's `rest`). Off by default
+  /// learns which occluders hide anything (soc's `rest`; occluded() hands
+  /// them out). Off by default
   /// (no cost); on, every texel also keeps the tag of the polygon its key
   /// came from, the smallest tag among those that wrote that same nearest
   /// key: like the keys, the same in any order and on any threads. The keys
@@ -336,14 +343,6 @@ class OcclusionBuffer {
   /// The tag the texels written by the single-call rasterize functions keep
   /// from now on (the batch call takes each draw's OccluderDraw::source).
   void set_source(std::uint32_t tag) noexcept { source_ = tag; }
-  /// With track_sources: appends to `out` the tags of the texels whose keys
-  /// occluded(box, view_proj) compares the box against, each run of equal
-  /// tags once (a tag may still appear more than once; no_source left out).
-  /// Appends nothing where occluded() would decide without texels (a box
-  /// off the buffer, reaching the eye, holding no pixel centre) or without
-  /// track_sources. Credit, not proof: call it for a box occluded() found
-  /// hidden, and every tag it appends hid part of it.
-  void sources_under(const Aabb& box, const glm::mat4& view_proj, std::vector<std::uint32_t>& out) const;
   /// Texel (x, y)'s tag (no_source without track_sources).
   [[nodiscard]] std::uint32_t source_at(int x, int y) const {
     return sources_.empty() ? no_source : sources_.at(std::size_t(y) * std::size_t(width_) + std::size_t(x));
@@ -433,11 +432,6 @@ class OcclusionBuffer {
   template <class PlaneOf>  // PlaneOf: () -> const DepthPlane* (null: no plane)
   void fill_region(Lane& lane, const Edge* edges, int edge_count, const TexelRect& r, PlaneOf&& plane_of) const;
   float tile_farthest(int tx, int ty);
-  /// What occluded() compares a box against: the texels `rect` (clamped to
-  /// the buffer) and the box's nearest key, or a decision made without
-  /// texels.
-  enum class BoxReach { visible, hidden, texels };
-  BoxReach box_reach(const Aabb& box, const glm::mat4& view_proj, TexelRect& rect, float& nearest) const;
   /// Half the side of what a texel must have inside a polygon to be covered
   /// (the texel, or with rule 10 its pixel centres' square), in texels.
   [[nodiscard]] double covered_half_side() const noexcept;

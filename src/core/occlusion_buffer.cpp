@@ -1089,14 +1089,13 @@ float OcclusionBuffer::tile_farthest(int tx, int ty) {
   return tile_far_[t];
 }
 
-OcclusionBuffer::BoxReach OcclusionBuffer::box_reach(const Aabb& box, const glm::mat4& view_proj, TexelRect& rect,
-                                                      float& nearest) const {
-  if (box.empty()) return BoxReach::visible;
+bool OcclusionBuffer::occluded(const Aabb& box, const glm::mat4& view_proj, std::vector<std::uint32_t>* sources) {
+  if (box.empty()) return false;
   const BoxFootprint f = project_box(box, view_proj, clip_, width_, height_);
-  if (f.reaches_eye && rules_.reaching_eye_visible) return BoxReach::visible;  // rule 7
-  if (f.projected == 0) return BoxReach::visible;
+  if (f.reaches_eye && rules_.reaching_eye_visible) return false;  // rule 7
+  if (f.projected == 0) return false;
   // Rule 6: the nearest corner, as a key.
-  nearest = clip_.reversed_z ? -f.max_depth : f.min_depth;
+  float nearest = clip_.reversed_z ? -f.max_depth : f.min_depth;
   if (!rules_.nearest_corner) {  // broken: the centre's depth
     const float depth = window_depth(box.center(), view_proj, clip_);
     nearest = clip_.reversed_z ? -depth : depth;
@@ -1114,38 +1113,18 @@ OcclusionBuffer::BoxReach OcclusionBuffer::box_reach(const Aabb& box, const glm:
     const auto first = [&](float v, int size) { return int(std::clamp(std::ceil(v - 1.0f + in), -1.0f, float(size))); };
     x0 = first(min_x - grow, width_), x1 = last(max_x + grow, width_);
     y0 = first(min_y - grow, height_), y1 = last(max_y + grow, height_);
-    if (x0 > x1 || y0 > y1) return BoxReach::visible;  // holds no pixel centre: not the buffer's to say (holds_no_sample)
+    if (x0 > x1 || y0 > y1) return false;  // holds no pixel centre: not the buffer's to say (holds_no_sample)
   } else if (rules_.outer_rectangle) {
     x0 = texel(min_x - grow, width_), x1 = texel(max_x + grow, width_);
     y0 = texel(min_y - grow, height_), y1 = texel(max_y + grow, height_);
   } else {  // texels whose centre lies in the rectangle (rule 5 broken)
     x0 = texel(std::ceil(min_x - 0.5f), width_), x1 = texel(max_x - 0.5f, width_);
     y0 = texel(std::ceil(min_y - 0.5f), height_), y1 = texel(max_y - 0.5f, height_);
-    if (x0 > x1 || y0 > y1) return BoxReach::hidden;  // no texel: nothing tested, nothing found visible
+    if (x0 > x1 || y0 > y1) return true;  // no texel: nothing tested, nothing found visible
   }
-  if (x1 < 0 || y1 < 0 || x0 >= width_ || y0 >= height_) return BoxReach::visible;  // off the buffer: the caller's frustum decides
-  rect = {std::max(x0, 0), std::min(x1, width_ - 1), std::max(y0, 0), std::min(y1, height_ - 1)};
-  return BoxReach::texels;
-}
-
-void OcclusionBuffer::sources_under(const Aabb& box, const glm::mat4& view_proj, std::vector<std::uint32_t>& out) const {
-  TexelRect r{};
-  float nearest = 0.0f;
-  if (sources_.empty() || box_reach(box, view_proj, r, nearest) != BoxReach::texels) return;
-  std::uint32_t last = no_source;
-  for (int y = r.y_lo; y <= r.y_hi; ++y) {
-    const std::uint32_t* row = sources_.data() + std::size_t(y) * std::size_t(width_);
-    for (int x = r.x_lo; x <= r.x_hi; ++x)
-      if (row[x] != last && row[x] != no_source) out.push_back(last = row[x]);
-  }
-}
-
-bool OcclusionBuffer::occluded(const Aabb& box, const glm::mat4& view_proj) {
-  TexelRect r{};
-  float nearest = 0.0f;
-  const BoxReach reach = box_reach(box, view_proj, r, nearest);
-  if (reach != BoxReach::texels) return reach == BoxReach::hidden;
-  const int x0 = r.x_lo, x1 = r.x_hi, y0 = r.y_lo, y1 = r.y_hi;
+  if (x1 < 0 || y1 < 0 || x0 >= width_ || y0 >= height_) return false;  // off the buffer: the caller's frustum decides
+  x0 = std::max(x0, 0), y0 = std::max(y0, 0);
+  x1 = std::min(x1, width_ - 1), y1 = std::min(y1, height_ - 1);
   const bool margin = rules_.depth_margin;
   for (int ty = y0 / tile_size; ty <= y1 / tile_size; ++ty)
     for (int tx = x0 / tile_size; tx <= x1 / tile_size; ++tx) {
@@ -1158,6 +1137,14 @@ bool OcclusionBuffer::occluded(const Aabb& box, const glm::mat4& view_proj) {
         if (!behind(nearest, far, margin)) return false;
       }
     }
+  if (sources && !sources_.empty()) {  // the tags of the texels compared, each run once
+    std::uint32_t last = no_source;
+    for (int y = y0; y <= y1; ++y) {
+      const std::uint32_t* row = sources_.data() + std::size_t(y) * std::size_t(width_);
+      for (int x = x0; x <= x1; ++x)
+        if (row[x] != last && row[x] != no_source) sources->push_back(last = row[x]);
+    }
+  }
   return true;
 }
 

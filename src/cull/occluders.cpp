@@ -40,7 +40,7 @@ bool Occluders::learns() {
 }
 
 bool Occluders::rests(ObjectId id) {
-  if (!restable_) return false;
+  if (!restable_ || scene_.object(id).triangles < std::uint64_t(choice_.rest_triangles)) return false;
   std::uint32_t& useful = useful_[id];
   // Met twice a frame: by soc's prepass, resting, then by its walk.
   const bool again = met_[id] == frame_;
@@ -49,7 +49,6 @@ bool Occluders::rests(ObjectId id) {
   const auto rest = std::uint32_t(choice_.rest);
   const std::uint32_t idle = frame_ - useful;
   if (idle <= rest) return false;
-  if (scene_.object(id).triangles < std::uint64_t(choice_.rest_triangles)) return false;
   // Tried again one frame in `period`: `rest`, doubled while it finds nothing, up to 8 × rest.
   std::uint32_t period = rest;
   while (period < 8 * rest && idle >= 2 * period) period *= 2;
@@ -58,12 +57,14 @@ bool Occluders::rests(ObjectId id) {
   return true;
 }
 
-void Occluders::credit(const OcclusionBuffer& buffer, const Aabb& box, const glm::mat4& view_proj) {
-  if (!restable_) return;
+bool Occluders::hidden(OcclusionBuffer& buffer, const Aabb& box, const glm::mat4& view_proj,
+                       BufferCounters& counters) {
+  if (!restable_) return test_box(buffer, box, view_proj, counters);
   tags_.clear();
-  buffer.sources_under(box, view_proj, tags_);
+  if (!test_box(buffer, box, view_proj, counters, &tags_)) return false;
   for (const std::uint32_t tag : tags_)
     if (tag < useful_.size()) useful_[tag] = frame_;
+  return true;
 }
 
 std::optional<OcclusionBuffer::OccluderDraw> Occluders::occluder_draw(ObjectId id, const Aabb& bounds,
@@ -103,10 +104,11 @@ void Occluders::rasterize(OcclusionBuffer& buffer, std::span<const OcclusionBuff
   counters.raster_ms += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
 }
 
-bool test_box(OcclusionBuffer& buffer, const Aabb& box, const glm::mat4& view_proj, BufferCounters& counters) {
-  if (counters.boxes_tested++ % kTestsPerTimedTest != 0) return buffer.occluded(box, view_proj);
+bool test_box(OcclusionBuffer& buffer, const Aabb& box, const glm::mat4& view_proj, BufferCounters& counters,
+              std::vector<std::uint32_t>* sources) {
+  if (counters.boxes_tested++ % kTestsPerTimedTest != 0) return buffer.occluded(box, view_proj, sources);
   const auto start = std::chrono::steady_clock::now();
-  const bool out = buffer.occluded(box, view_proj);
+  const bool out = buffer.occluded(box, view_proj, sources);
   counters.test_ms += double(kTestsPerTimedTest) *
                       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   return out;

@@ -32,12 +32,13 @@ struct BufferCounters {
   }
 };
 
-/// Tests `box` against `buffer` (OcclusionBuffer::occluded) and counts it in
-/// counters.boxes_tested. Only one test in kTestsPerTimedTest is timed, and its
+/// Tests `box` against `buffer` (OcclusionBuffer::occluded, `sources` passed
+/// on) and counts it in counters.boxes_tested. Only one test in kTestsPerTimedTest is timed, and its
 /// time times kTestsPerTimedTest added to counters.test_ms: reading the clock
 /// twice costs about as much as a quick box test (docs/performance.md, "The
 /// walk's cost per box"), so test_ms is a sampled estimate.
-bool test_box(OcclusionBuffer& buffer, const Aabb& box, const glm::mat4& view_proj, BufferCounters& counters);
+bool test_box(OcclusionBuffer& buffer, const Aabb& box, const glm::mat4& view_proj, BufferCounters& counters,
+              std::vector<std::uint32_t>* sources = nullptr);
 inline constexpr std::uint64_t kTestsPerTimedTest = 8;
 
 /// Occluders: opaque objects of class `always`, and of class `sometimes`
@@ -56,10 +57,10 @@ class Occluders {
   /// Starts a frame on `buffer` (already cleared) seen through `view`.
   /// Throws UsageError where learns() and the buffer does not track sources.
   void begin_frame(const View& view, const OcclusionBuffer& buffer);
-  /// With OccluderChoice::rest: `box` was found hidden in `buffer`; the
-  /// occluders whose texels it was compared against hid something this
-  /// frame and are not resting for `rest` frames. Without rest: nothing.
-  void credit(const OcclusionBuffer& buffer, const Aabb& box, const glm::mat4& view_proj);
+  /// test_box; and where learns(), a box found hidden credits the
+  /// occluders whose texels it was compared against: they hid something
+  /// this frame and do not rest for `rest` frames.
+  bool hidden(OcclusionBuffer& buffer, const Aabb& box, const glm::mat4& view_proj, BufferCounters& counters);
   /// Occluders resting this frame (OccluderChoice::rest), so far.
   [[nodiscard]] std::uint64_t resting() const noexcept { return resting_; }
   /// Rasterizes object `id` if it is an occluder; adds the time and
@@ -99,7 +100,7 @@ class Occluders {
   std::uint32_t frame_ = 1;            // frames begun, plus 1, for rest (no object met in frame 1 - 1)
   std::vector<std::uint32_t> useful_;  // per object, with rest: the last frame it hid something, or came into view
   std::vector<std::uint32_t> met_;     // per object, with rest: the last frame it was met as an occluder (0: never)
-  std::vector<std::uint32_t> tags_;    // sources_under's (scratch)
+  std::vector<std::uint32_t> tags_;    // a hidden box's sources (scratch)
   std::uint64_t resting_ = 0;          // this frame
   bool restable_ = false;              // learns(): some occluder of the objects checked may rest
   std::size_t restable_checked_ = 0;   // objects checked for restable_ so far

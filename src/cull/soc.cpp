@@ -20,7 +20,7 @@
 // conservative: an occluder of many polygons that has hidden nothing for
 // `rest` frames rests (not rasterized, still drawn), tried again now and
 // then; the buffer tags each texel with the occluder that wrote it, and a
-// box found hidden credits the tags under it (Occluders::credit).
+// box found hidden credits the tags under it (Occluders::hidden).
 // An interior node that held a drawn object in the last frame is not
 // tested, against the buffer nor for holding a pixel centre: it is most
 // likely visible again, and its children are tested. A
@@ -101,7 +101,7 @@ class SocCuller final : public Culler {
       }
       occluders_.rasterize(buffer, draws_, view, counters);
       for (const ObjectId id : prepassed_)
-        if (!hidden(buffer, index_.scene.object(id).bounds, view, counters)) {
+        if (!occluders_.hidden(buffer, index_.scene.object(id).bounds, view.view_proj, counters)) {
           queue_.push_back(id);
           queued_[id] = frame_;
         }
@@ -114,7 +114,7 @@ class SocCuller final : public Culler {
       ++result.nodes_visited;
       const bool shown_last_frame = !bvh.is_leaf(n) && shown_[n] + 1 == frame_;
       if (bvh.node(n).object_count == 0 || frustum_.outside(bvh, n, !shown_last_frame)) continue;
-      if (n != Bvh::root() && !shown_last_frame && hidden(buffer, bvh.node(n).bounds, view, counters))
+      if (n != Bvh::root() && !shown_last_frame && occluders_.hidden(buffer, bvh.node(n).bounds, view.view_proj, counters))
         continue;
       if (!bvh.is_leaf(n)) {
         open.push(bvh, Bvh::left(n), view.eye);
@@ -127,7 +127,7 @@ class SocCuller final : public Culler {
       const bool tested = leaf_.size() == 1 && bvh.node(n).object_count == 1 && n != Bvh::root();
       for (ObjectId id : leaf_) {
         const Aabb& box = tested ? bvh.node(n).bounds : index_.scene.object(id).bounds;
-        if (!tested && hidden(buffer, box, view, counters)) continue;
+        if (!tested && occluders_.hidden(buffer, box, view.view_proj, counters)) continue;
         if (prerasterized_[id] == frame_) {
           // Rasterized by the prepass; in the next prepass only if found visible again. (Found hidden after the
           // prepass, it cannot be visible now: drawing it anyway is safe.)
@@ -147,13 +147,6 @@ class SocCuller final : public Culler {
   [[nodiscard]] const OcclusionBuffer* occlusion_buffer() const override { return buffer_ ? &*buffer_ : nullptr; }
 
  private:
-  /// test_box, and a box found hidden credits the occluders that hid it (rest).
-  bool hidden(OcclusionBuffer& buffer, const Aabb& box, const View& view, BufferCounters& counters) {
-    if (!test_box(buffer, box, view.view_proj, counters)) return false;
-    occluders_.credit(buffer, box, view.view_proj);
-    return true;
-  }
-
   OcclusionBuffer& buffer_for(const View& view) {
     const int scale = config_.scale > 0 ? config_.scale : std::max(1, view.width / SocConfig::auto_width);
     const int w = config_.width > 0 ? config_.width : std::max(1, view.width / scale);
