@@ -40,16 +40,21 @@ kinds=(mixed tiny thin coplanar near far farout)
 paths=(walk graze far)
 modes=(samples any conservative)
 cullers="vfc,stopwait,chc,chc:cpu_test=on,chcpp,chcpp:virtual_leaf=0,chcpp:cpu_test=on,nohc,nohc:cpu_test=on,hiz,hiz:texels=2,soc,soc:scale=1:prepass=off,soc:scale=4:prepass=off:threads=1:rest=0,soc:rest=1:rest_triangles=0,auto"
+IFS=, read -ra culler_list <<< "$cullers"
+culler_count=${#culler_list[@]}
 if [[ $short -eq 1 ]]; then objects=600; frames=12; else objects=3000; frames=30; fi
 
 RANDOM=$((seed % 32768))
-pick() { local -n a=$1; echo "${a[$((RANDOM % ${#a[@]}))]}"; }
+# Both set a variable rather than print: bash reseeds RANDOM in a command
+# substitution's subshell, and --seed would not repeat a campaign.
+pick() { local -n a=$1 into=$2; into=${a[$((RANDOM % ${#a[@]}))]}; }
 offset_of() {  # 0, or 1 km to 1,000 km either way along x and z
+  local -n into=$1
   case $((RANDOM % 4)) in
-    0) echo 0 ;;
-    1) echo $(( (RANDOM % 2 ? 1 : -1) * (1000 + RANDOM % 9000) )) ;;
-    2) echo $(( (RANDOM % 2 ? 1 : -1) * (10000 + RANDOM * 3) )) ;;
-    *) echo $(( (RANDOM % 2 ? 1 : -1) * (100000 + RANDOM * 27) )) ;;
+    0) into=0 ;;
+    1) into=$(( (RANDOM % 2 ? 1 : -1) * (1000 + RANDOM % 9000) )) ;;
+    2) into=$(( (RANDOM % 2 ? 1 : -1) * (10000 + RANDOM * 3) )) ;;
+    *) into=$(( (RANDOM % 2 ? 1 : -1) * (100000 + RANDOM * 27) )) ;;
   esac
 }
 
@@ -59,7 +64,7 @@ echo "conservative campaign: $runs runs, seed $seed, $objects objects, $frames f
 checked=0
 missed=0
 for ((r = 1; r <= runs; ++r)); do
-  kind=$(pick kinds); path=$(pick paths); mode=$(pick modes); offset=$(offset_of)
+  pick kinds kind; pick paths path; pick modes mode; offset_of offset
   scene="adversarial:kind=$kind,seed=$(( (RANDOM * 32768 + RANDOM) % 1000000000 )),objects=$objects,offset=$offset"
   cmd=("$occull" bench --scene "$scene" --path "$path" --query-mode "$mode" --algo "$cullers"
        --frames "$frames" --warmup 2 --size 320x180 --no-report --json "$tmp/run.json")
@@ -82,4 +87,4 @@ for ((r = 1; r <= runs; ++r)); do
     echo "run $r MISSED visible objects: ${cmd[*]}"; grep -E "verification|first" "$tmp/out.txt" || true; exit 1
   fi
 done
-echo "campaign: $runs runs, $checked object-frames checked over $((runs * 14)) culler runs, $missed missed (seed $seed)"
+echo "campaign: $runs runs, $checked object-frames checked over $((runs * culler_count)) culler runs, $missed missed (seed $seed)"
