@@ -57,7 +57,7 @@ void expect_violation(const std::string& message, const std::string& invariant) 
 }  // namespace
 
 TEST(Invariants, HoldOnAnUnbrokenRun) {
-  EXPECT_EQ(violation_of(small_bench({"vfc", "chcpp", "oracle"})), "");
+  EXPECT_EQ(violation_of(small_bench({"vfc", "chcpp", "oracle", "oracle:set=boxes"})), "");
 }
 
 TEST(Invariants, TruthWithAnObjectOutsideTheFrustumStopsTheRun) {
@@ -137,6 +137,26 @@ TEST(Invariants, OracleFrameWithOtherDepthStopsTheRun) {
     *covered = 1.0f;
   };
   expect_violation(violation_of(c), "oracle-draws-truth");
+}
+
+TEST(Invariants, BoxReachLeavingOutAVisibleObjectStopsTheRun) {
+  BenchConfig c = small_bench({"oracle:set=boxes"});
+  hooks(c).box_reach = [](std::vector<ObjectId>& reach) {
+    ASSERT_FALSE(reach.empty());
+    reach.erase(reach.begin());  // the truth's objects are most of the reach: the first is one of them
+  };
+  expect_violation(violation_of(c), "box-reach-holds-truth");
+}
+
+TEST(Invariants, OracleOfBoxesLeavingOutAnObjectOfTheReachStopsTheRun) {
+  BenchConfig c = small_bench({"oracle:set=boxes"});
+  hooks(c).oracle_objects = [](std::vector<ObjectId>& reach) {
+    ASSERT_FALSE(reach.empty());
+    reach.pop_back();
+  };
+  const std::string message = violation_of(c);
+  expect_violation(message, "oracle-draws-truth");
+  EXPECT_NE(message.find("1 missing"), std::string::npos) << message;
 }
 
 TEST(Invariants, CpuProbeFindsTrianglesToTestOnAPlainView) {

@@ -184,6 +184,39 @@ TEST(DepthErrors, PixelsNearerThanTheirBoxAreTheRasterisersOnly) {
   }
 }
 
+// The box bound on the same image: the cube's box reaches in front of the
+// depth where the depth lies at or behind its front face.
+TEST(BoxReach, ABoxReachesWhereItLiesNoFartherThanTheDepth) {
+  const auto reach = [](const DepthErrorImage& image) {
+    const std::vector<ObjectId> all{0};
+    return !boxes_reaching_depth(image.scene, image.view, all, image.depth, 8, 8).empty();
+  };
+  for (DepthMode mode : {DepthMode::standard, DepthMode::reversed}) {
+    EXPECT_FALSE(reach(DepthErrorImage(mode, 5.0f))) << int(mode);  // a wall before it
+    EXPECT_TRUE(reach(DepthErrorImage(mode, 9.0f))) << int(mode);   // its front face
+    EXPECT_TRUE(reach(DepthErrorImage(mode, 10.5f))) << int(mode);
+    EXPECT_TRUE(reach(DepthErrorImage(mode, 20.0f))) << int(mode);
+    // Within a rasteriser's error of its face (1 mm, 9 m away): reaches. 5 cm nearer: hidden.
+    EXPECT_TRUE(reach(DepthErrorImage(mode, 8.999f))) << int(mode);
+    EXPECT_FALSE(reach(DepthErrorImage(mode, 8.95f))) << int(mode);
+    // One pixel is enough.
+    DepthErrorImage one(mode, 5.0f);
+    one.depth[27] = DepthErrorImage(mode, 9.5f).depth[27];
+    EXPECT_TRUE(reach(one)) << int(mode);
+    // Pixels showing nothing: anything on their rays reaches.
+    DepthErrorImage none(mode, 5.0f);
+    std::fill(none.depth.begin(), none.depth.end(), 1.0f);
+    EXPECT_TRUE(reach(none)) << int(mode);
+    // A box beside the image holds none of its pixels; one around the eye
+    // reaches whatever the depth.
+    DepthErrorImage aside(mode, 20.0f);
+    aside.scene = test::box_scene({{{40, -1, -11}, {42, 1, -9}}, {{-1, -1, -1}, {1, 1, 1}}});
+    const std::vector<ObjectId> both{0, 1};
+    EXPECT_EQ(boxes_reaching_depth(aside.scene, aside.view, both, aside.depth, 8, 8), std::vector<ObjectId>{1})
+        << int(mode);
+  }
+}
+
 TEST(SummarizeRuns, MediansOverRepeatsAndRatiosWithinARepeat) {
   const auto run = [](const char* name, int rep, std::vector<double> ms, std::uint32_t missed) {
     AlgorithmRun r{name, rep, true, {}, 0};

@@ -65,6 +65,11 @@ struct FrameTruth {
   /// Objects of the frustum whose boxes hold no sample (holds_no_sample):
   /// none of them is in `visible` (invariant truth-holds-samples).
   std::uint32_t subpixel = 0;
+  /// Filled only when the session was asked (Session::set_box_reach): the
+  /// objects of the frustum whose boxes reach in front of the truth's depth
+  /// (boxes_reaching_depth), ascending. Every object of `visible` but those
+  /// of `depth_error_only` is among them (invariant box-reach-holds-truth).
+  std::vector<ObjectId> box_reach;
 };
 
 /// The share of the distance from the eye by which a pixel's depth may lie
@@ -95,6 +100,23 @@ inline constexpr double kDepthErrorTolerance = 1e-4;
                                                                    std::span<const std::uint32_t> ids,
                                                                    std::span<const float> depth, int width,
                                                                    int height);
+
+/// The objects of `objects` whose boxes reach in front of the depth image
+/// (canonical window depth, read_depth(); width * height values, bottom row
+/// first) at some pixel centre: where the pixel's ray enters the box, grown
+/// and with the depth read at its farthest as seen_only_through_depth_errors
+/// does, no nearer than kDepthErrorTolerance of its distance behind the
+/// pixel's depth (a pixel showing nothing: anywhere along its ray). A
+/// box that reaches the near plane counts as reaching. Ascending ids.
+///
+/// It is the bound of every culler that decides an object by a test of its
+/// own box against the depth of other objects (queries, soc's buffer, hiz's
+/// pyramid): the depth they test against lies at or behind the full scene's
+/// at each pixel, so each draws at least these objects (and leaves out at
+/// most those of the frustum that are not). `oracle:set=boxes` draws them.
+[[nodiscard]] std::vector<ObjectId> boxes_reaching_depth(const Scene& scene, const View& view,
+                                                         std::span<const ObjectId> objects,
+                                                         std::span<const float> depth, int width, int height);
 
 /// Called as work progresses: a label (algorithm name, or "ground truth"),
 /// the step just done (0-based), the number of steps, and whether it was a
@@ -306,6 +328,10 @@ class Session {
   /// Throws InputError for reversed depth on a tiled world (its window of
   /// tiles is sized by a finite far plane).
   void set_depth(DepthMode depth);
+  /// Whether the ground truth from now on also lists FrameTruth::box_reach
+  /// (off by default: it reads every box of the frustum against the truth's
+  /// depth, pixel by pixel). `oracle:set=boxes` needs it.
+  void set_box_reach(bool on) noexcept { box_reach_ = on; }
   /// Objects moved by the engine, for benchmarks (--engine-moves): from now
   /// on, before every frame and its truth, `fraction` of the static objects
   /// (every round(1 / fraction)-th; 0: none) are moved with
@@ -406,6 +432,7 @@ class Session {
   std::unique_ptr<detail::Watchdog> watchdog_;
   std::optional<HardwareProfile> profile_;
   std::shared_ptr<const detail::FaultHooks> hooks_;
+  bool box_reach_ = false;
   FrameTruth truth_of(const View& view, const detail::FrameLabel& where);
   FrameSampling sampling_;
 };

@@ -30,7 +30,11 @@ const std::vector<Registration>& registry() {
     };
     // The oracle is made by the lab (it needs each frame's ground truth).
     r.push_back({{"oracle", "renders exactly the ground-truth visible set, no queries: the lower bound (occull bench only)",
-                  true, {}, true, SceneKind::any},
+                  true,
+                  {{"set", "pixels", "pixels|boxes",
+                    "pixels: the objects with a visible pixel; boxes: the objects whose boxes reach in front of the "
+                    "full scene's depth at a pixel centre, the bound of every culler that tests an object by its box"}},
+                  true, SceneKind::any},
                  {},
                  {},
                  {},

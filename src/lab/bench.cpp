@@ -271,7 +271,12 @@ BenchResult run_bench(const BenchConfig& config, const ProgressFn& progress) {
     if (progress) progress(line, 0, 0, false);
   };
   if (config.model) (void)session.hardware_profile(say);
-  for (const auto& n : names) (void)session.make(n, config.options, say);
+  for (const auto& n : names) {
+    (void)session.make(n, config.options, say);
+    const AlgorithmSpec spec = parse_algorithm_spec(n, config.options);
+    const auto set = spec.options.values().find("oracle.set");
+    if (spec.name == "oracle" && set != spec.options.values().end() && set->second == "boxes") session.set_box_reach(true);
+  }
   std::string profile_path = session.has_hardware_profile() ? session.hardware_profile_path() : "";
   for (const auto& n : names)
     if (const AlgorithmSpec spec = parse_algorithm_spec(n, config.options); spec.options.has("nohc.profile"))

@@ -19,6 +19,8 @@ struct FaultHooks {
   /// What the truth pass found and the images it read back.
   std::function<void(std::vector<gl::Renderer::ObjectPixels>& visible, gl::Renderer::PassImages& images)>
       truth_images;
+  /// The box reach the truth computed (Session::set_box_reach).
+  std::function<void(std::vector<ObjectId>& reach)> box_reach;
   /// The objects the oracle is told to render.
   std::function<void(std::vector<ObjectId>& visible)> oracle_objects;
   /// The depth image of a verified frame of an algorithm, as read back.

@@ -236,28 +236,46 @@ void check_frame_within_truth(const FrameLabel& where, const std::string& algori
                                    algorithm, outside, first, truth.pixels, frame.pixels));
 }
 
-void check_oracle_draws_truth(const FrameLabel& where, std::span<const gl::Renderer::ObjectPixels> visible,
-                              std::span<const ObjectId> rendered, std::uint64_t truth_depth_hash,
-                              std::uint64_t frame_depth_hash) {
+void check_oracle_draws(const FrameLabel& where, std::span<const ObjectId> expected, std::span<const ObjectId> rendered) {
   std::vector<ObjectId> drawn(rendered.begin(), rendered.end());
   std::sort(drawn.begin(), drawn.end());
   drawn.erase(std::unique(drawn.begin(), drawn.end()), drawn.end());
+  if (std::equal(drawn.begin(), drawn.end(), expected.begin(), expected.end())) return;
+  std::vector<ObjectId> missing, extra;
+  std::set_difference(expected.begin(), expected.end(), drawn.begin(), drawn.end(), std::back_inserter(missing));
+  std::set_difference(drawn.begin(), drawn.end(), expected.begin(), expected.end(), std::back_inserter(extra));
+  invariant_violated(where, "oracle-draws-truth",
+                     fmt::format("the oracle drew {} objects for a set of {}: {} missing (first {}), {} "
+                                 "extra (first {})",
+                                 drawn.size(), expected.size(), missing.size(),
+                                 missing.empty() ? std::string("-") : std::to_string(missing[0]), extra.size(),
+                                 extra.empty() ? std::string("-") : std::to_string(extra[0])));
+}
+
+void check_oracle_draws_truth(const FrameLabel& where, std::span<const gl::Renderer::ObjectPixels> visible,
+                              std::span<const ObjectId> rendered, std::uint64_t truth_depth_hash,
+                              std::uint64_t frame_depth_hash) {
   std::vector<ObjectId> truth;
   for (const auto& v : visible) truth.push_back(v.id);
-  if (drawn != truth) {
-    std::vector<ObjectId> missing, extra;
-    std::set_difference(truth.begin(), truth.end(), drawn.begin(), drawn.end(), std::back_inserter(missing));
-    std::set_difference(drawn.begin(), drawn.end(), truth.begin(), truth.end(), std::back_inserter(extra));
-    invariant_violated(where, "oracle-draws-truth",
-                       fmt::format("the oracle drew {} objects for a truth of {}: {} missing (first {}), {} "
-                                   "extra (first {})",
-                                   drawn.size(), truth.size(), missing.size(),
-                                   missing.empty() ? std::string("-") : std::to_string(missing[0]), extra.size(),
-                                   extra.empty() ? std::string("-") : std::to_string(extra[0])));
-  }
+  check_oracle_draws(where, truth, rendered);
   if (truth_depth_hash != frame_depth_hash)
     invariant_violated(where, "oracle-draws-truth",
                        "the oracle drew the truth's objects but its depth image differs from the truth pass's");
+}
+
+void check_box_reach_holds_truth(const FrameLabel& where, std::span<const gl::Renderer::ObjectPixels> visible,
+                                 std::span<const ObjectId> depth_error_only, std::span<const ObjectId> box_reach) {
+  std::size_t outside = 0;
+  ObjectId first = 0;
+  for (const auto& v : visible)
+    if (!std::binary_search(box_reach.begin(), box_reach.end(), v.id) &&
+        !std::binary_search(depth_error_only.begin(), depth_error_only.end(), v.id))
+      if (outside++ == 0) first = v.id;
+  if (outside > 0)
+    invariant_violated(where, "box-reach-holds-truth",
+                       fmt::format("{} visible objects (first {}) have boxes that reach in front of the truth's depth "
+                                   "at no pixel centre",
+                                   outside, first));
 }
 
 }  // namespace occull::detail

@@ -22,6 +22,11 @@
 //                             covered in the truth (it draws a subset)
 //   oracle-draws-truth        the oracle renders exactly the truth's objects
 //                             and reproduces its depth image bit for bit
+//                             (oracle:set=boxes: exactly the box reach)
+//   box-reach-holds-truth     every object of the truth (but those seen only
+//                             through depth errors) has a box that reaches
+//                             in front of the truth's depth (when the
+//                             session computes the box reach)
 #pragma once
 
 #include "occull/gl/renderer.hpp"
@@ -80,6 +85,13 @@ std::size_t check_truth_probes(const FrameLabel& where, const Scene& scene, cons
 /// frame-within-truth.
 void check_frame_within_truth(const FrameLabel& where, const std::string& algorithm,
                               const Coverage& truth, const Coverage& frame);
+
+/// oracle-draws-truth for a set of objects: the oracle handed the backend
+/// (`rendered`) exactly `expected` (ascending).
+void check_oracle_draws(const FrameLabel& where, std::span<const ObjectId> expected, std::span<const ObjectId> rendered);
+/// box-reach-holds-truth. `depth_error_only` and `box_reach` ascending.
+void check_box_reach_holds_truth(const FrameLabel& where, std::span<const gl::Renderer::ObjectPixels> visible,
+                                 std::span<const ObjectId> depth_error_only, std::span<const ObjectId> box_reach);
 
 /// oracle-draws-truth. `rendered`: the objects the oracle handed the backend.
 void check_oracle_draws_truth(const FrameLabel& where, std::span<const gl::Renderer::ObjectPixels> visible,

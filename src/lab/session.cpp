@@ -266,7 +266,13 @@ void Session::check_queries_returned(std::string_view who) const {
 std::unique_ptr<Culler> Session::make(std::string_view spec, const Options& options,
                                       const std::function<void(const std::string&)>& progress) {
   const AlgorithmSpec a = parse_algorithm_spec(spec, options);
-  if (a.name == "oracle") return std::make_unique<detail::OracleCuller>(bundle_.scene);
+  if (a.name == "oracle") {
+    const auto set = a.options.values().find("oracle.set");
+    const std::string value = set == a.options.values().end() ? "pixels" : set->second;
+    if (value != "pixels" && value != "boxes")
+      throw InputError(fmt::format("option oracle.set: '{}' is not one of pixels, boxes", value));
+    return std::make_unique<detail::OracleCuller>(bundle_.scene, value == "boxes");
+  }
   return make_culler(a.name, index(), a.options, culler_context(progress));
 }
 
@@ -331,9 +337,15 @@ FrameStats Session::run_path_frame(Culler& culler, const CameraPath& path, int k
                                    const std::vector<FrameTruth>* truth) {
   if (auto* oracle = dynamic_cast<detail::OracleCuller*>(&culler)) {
     if (!truth) throw InputError("the oracle needs ground truth: run it with verification on");
+    const FrameTruth& t = (*truth)[std::size_t(k)];
     std::vector<ObjectId> visible;
-    visible.reserve((*truth)[std::size_t(k)].visible.size());
-    for (const auto& t : (*truth)[std::size_t(k)].visible) visible.push_back(t.id);
+    if (oracle->boxes()) {
+      if (!box_reach_) throw InputError("oracle:set=boxes needs the box reach: Session::set_box_reach(true)");
+      visible = t.box_reach;
+    } else {
+      visible.reserve(t.visible.size());
+      for (const auto& v : t.visible) visible.push_back(v.id);
+    }
     if (hooks_ && hooks_->oracle_objects) hooks_->oracle_objects(visible);
     oracle->set_visible(std::move(visible));
   }
