@@ -138,6 +138,12 @@ TEST(Cli, UnknownOptionListsValidOptions) {
   EXPECT_NE(r.output.find("valid options"), std::string::npos) << r.output;
 }
 
+TEST(Cli, OracleOfAnUnknownSetListsTheValidOnes) {
+  const CliRun r = run(std::string("bench ") + kTinyCity + " --algo oracle:set=objects --frames 1 --no-report");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.output.find("'objects' is not one of pixels, boxes"), std::string::npos) << r.output;
+}
+
 TEST(Cli, InfoNamesTheRenderer) {
   const CliRun r = run("info");
   EXPECT_EQ(r.code, 0) << r.output;
