@@ -281,6 +281,32 @@ TEST(Verdict, MissesOfConservativeRunsFailThoseOfOthersArePopping) {
   EXPECT_TRUE(verification_failures(r).empty());
 }
 
+TEST(Report, OcclusionCapturedIsTheShareOfTheOraclesAndTheBoxBoundsCulling) {
+  const auto run = [](const char* name, std::uint64_t draws) {
+    AlgorithmRun r{name, 0, true, {}, 0};
+    FrameStats f;
+    f.frame_ms = 1.0;
+    f.objects_rendered = draws;
+    r.frames.assign(2, f);
+    return r;
+  };
+  BenchResult r;
+  r.width = r.height = 8;
+  r.frames = 2;
+  const auto table = [&] {
+    r.summaries = summarize_runs(r.runs);
+    std::ostringstream out;
+    print_table(r, out);
+    return out.str();
+  };
+  r.runs = {run("vfc", 1000), run("soc", 680), run("oracle", 200), run("oracle:set=boxes", 400)};
+  EXPECT_NE(table().find("oracle:set=boxes): soc 0.40 / 0.53\n"), std::string::npos) << table();
+  r.runs.pop_back();
+  EXPECT_NE(table().find("down to the oracle's): soc 0.40\n"), std::string::npos) << table();
+  r.runs.pop_back();  // no oracle: nothing to share
+  EXPECT_EQ(table().find("occlusion captured"), std::string::npos) << table();
+}
+
 TEST(GroundTruth, WallHidesTheBoxBehindItNotTheOneBeside) {
   auto context = gl::Context::create();
   const Scene scene = test::box_scene({{{-3, -3, -11}, {3, 3, -10}},   // wall

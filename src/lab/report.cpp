@@ -128,6 +128,36 @@ std::string auto_line(const BenchResult& r, const AlgorithmSummary& a) {
                      a.auto_tries, a.auto_switches, predicted, r.repeat > 1 ? " (median of the repeats)" : "");
 }
 
+// How much of the occlusion each culler captured, from the draws per frame:
+// the share of the culling from the frustum baseline's draws down to the
+// oracle's, and down to the box bound's (oracle:set=boxes) when it ran. Empty
+// without the baseline and the oracle, on split-screen runs, or when the
+// oracle culls nothing beyond the frustum.
+std::string capture_line(const BenchResult& r) {
+  const AlgorithmSummary *base = nullptr, *oracle = nullptr, *bound = nullptr;
+  for (const AlgorithmSummary& a : r.summaries) {
+    if (a.name.find(" [view ") != std::string::npos) return "";
+    if (a.name == vfc_baseline(false) || a.name == vfc_baseline(true)) base = &a;
+    if (a.name == "oracle" || a.name == "oracle:set=pixels") oracle = &a;
+    if (a.name == "oracle:set=boxes") bound = &a;
+  }
+  if (!base || !oracle || base->objects_rendered_per_frame - oracle->objects_rendered_per_frame < 0.5) return "";
+  const auto share = [&](const AlgorithmSummary& a, const AlgorithmSummary& to) {
+    const double range = base->objects_rendered_per_frame - to.objects_rendered_per_frame;
+    return range < 0.5 ? std::string("-")
+                       : fmt::format("{:.2f}", (base->objects_rendered_per_frame - a.objects_rendered_per_frame) / range);
+  };
+  std::string shares;
+  for (const AlgorithmSummary& a : r.summaries) {
+    if (&a == base || &a == oracle || &a == bound) continue;
+    shares += fmt::format("{}{} {}{}", shares.empty() ? "" : ", ", a.name, share(a, *oracle),
+                          bound ? " / " + share(a, *bound) : "");
+  }
+  if (shares.empty()) return "";
+  return fmt::format("occlusion captured (share of the culling from {}'s draws down to the oracle's{}): {}",
+                     base->name, bound ? " / down to the box bound's, oracle:set=boxes" : "", shares);
+}
+
 std::string misses_text(const BenchResult& r, std::uint64_t v) {
   return r.verified ? fmt::format("{}", v) : "-";
 }
@@ -157,6 +187,7 @@ void print_table(const BenchResult& r, std::ostream& out) {
   }
   if (r.verified) out << "\n";
   for (const std::string& line : verdict_lines(r)) out << line << "\n";
+  if (const std::string line = capture_line(r); !line.empty()) out << line << "\n";
   for (const AlgorithmSummary& a : r.summaries) {
     if (a.result_age_frames > 0 || a.capped_share > 0)
       out << fmt::format("{}: query cap reached in {:.0f}% of frames, {:.1f} queries deferred per frame, answers "
@@ -403,6 +434,7 @@ std::vector<std::string> write_report(const BenchResult& r, const std::string& d
   }
   md += "\n";
   for (const std::string& line : verdict_lines(r)) md += "**" + line + "**\n\n";
+  if (const std::string line = capture_line(r); !line.empty()) md += line + "\n\n";
   for (const AlgorithmSummary& a : r.summaries)
     if (!a.auto_choices.empty()) md += auto_line(r, a) + "\n\n";
   md += "Frame times are wall clock, each frame closed by `glFinish`; ratios compare means measured in "
