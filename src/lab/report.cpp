@@ -130,9 +130,11 @@ std::string auto_line(const BenchResult& r, const AlgorithmSummary& a) {
 
 // How much of the occlusion each culler captured, from the draws per frame:
 // the share of the culling from the frustum baseline's draws down to the
-// oracle's, and down to the box bound's (oracle:set=boxes) when it ran. Empty
-// without the baseline and the oracle, on split-screen runs, or when the
-// oracle culls nothing beyond the frustum.
+// oracle's, and down to the box bound's (oracle:set=boxes) when it ran. An
+// algorithm that draws more than the baseline (none: it culls nothing, not
+// even by the frustum) is left out. Empty without the baseline and the
+// oracle, on split-screen runs, or when the oracle culls nothing beyond the
+// frustum.
 std::string capture_line(const BenchResult& r) {
   const AlgorithmSummary *base = nullptr, *oracle = nullptr, *bound = nullptr;
   for (const AlgorithmSummary& a : r.summaries) {
@@ -150,6 +152,7 @@ std::string capture_line(const BenchResult& r) {
   std::string shares;
   for (const AlgorithmSummary& a : r.summaries) {
     if (&a == base || &a == oracle || &a == bound) continue;
+    if (a.objects_rendered_per_frame > base->objects_rendered_per_frame) continue;
     shares += fmt::format("{}{} {}{}", shares.empty() ? "" : ", ", a.name, share(a, *oracle),
                           bound ? " / " + share(a, *bound) : "");
   }
