@@ -11,6 +11,7 @@
 
 #include <algorithm>
 #include <functional>
+#include <numeric>
 
 using namespace occull;
 
@@ -27,11 +28,14 @@ struct Counters {
   double auto_predicted_ms;
 };
 
+// The schedule's rules without the budget in the way (budget 1: with costs
+// of a few units per frame, its credit always covers a try).
 AutoConfig config() {
   AutoConfig c;
   c.trial = 2;
   c.period = 10;
   c.margin = 0.05;
+  c.budget = 1.0;
   return c;
 }
 
@@ -143,6 +147,74 @@ TEST(AutoSchedule, TakesACheaperChallengerWithinTrialPlusSixteenPeriods) {
   const auto ran = run(s, {1.0, 0.5}, c.trial + 16 * c.period + 1);
   EXPECT_EQ(s.current(), 1u) << "the cheaper challenger took over within trial + 16 x period frames";
   EXPECT_EQ(ran.back(), 1u);
+}
+
+TEST(AutoSchedule, TriesAfterTheStartsRoundSpendAtMostTheBudgetOfAnySecond) {
+  // A loser at 1.5 ms a frame against the current's 1 ms, due for a try
+  // every few frames (period 1): the budget alone holds it back. Over every
+  // run of frames that lasts a second, its frames cost at most 2 % of it
+  // above what the current would have cost.
+  AutoConfig c = config();
+  c.period = 1;
+  c.budget = 0.02;
+  detail::AutoSchedule s(c, 2);
+  std::vector<double> ms, excess;
+  for (int k = 0; k < 20000; ++k) {
+    const bool loser = s.next() == 1;
+    const double cost = loser ? 1.5 : 1.0;
+    if (k > 5) {  // after the start's round (an uncounted frame and two tries of two frames)
+      ms.push_back(cost);
+      excess.push_back(loser ? cost - 1.0 : 0.0);
+    }
+    s.finished(cost);
+  }
+  ASSERT_EQ(s.current(), 0u);
+  EXPECT_GE(s.tries(), 150u) << "the loser is still tried: the budget is spent, not hoarded";
+  // Every window of frames summing to at most 1000 ms.
+  double worst = 0.0;
+  std::size_t begin = 0;
+  double window_ms = 0.0, window_excess = 0.0;
+  for (std::size_t end = 0; end < ms.size(); ++end) {
+    window_ms += ms[end];
+    window_excess += excess[end];
+    while (window_ms > 1000.0) {
+      window_ms -= ms[begin];
+      window_excess -= excess[begin++];
+    }
+    worst = std::max(worst, window_excess);
+  }
+  EXPECT_LE(worst, 0.02 * 1000.0 + 1e-9) << "the tries' cost above the current's in the worst second, ms";
+  EXPECT_NEAR(s.spent_ms(), std::accumulate(excess.begin(), excess.end(), 0.0), 1e-6);
+}
+
+TEST(AutoSchedule, NoTriesAfterTheStartsRoundWithoutABudget) {
+  AutoConfig c = config();
+  c.budget = 0.0;
+  detail::AutoSchedule s(c, 2);
+  const auto ran = run(s, {1.0, 1.2}, 2000);
+  EXPECT_EQ(std::count(ran.begin() + 5, ran.end(), 1u), 0);
+  EXPECT_EQ(s.tries(), 2u) << "the start's round: one try each";
+}
+
+TEST(AutoSchedule, FollowsTheCheaperOnceItsPeriodIsDueAndTheCreditCoversItsTry) {
+  // Candidate 1 lost at 1.2 against 1 (within cut): each further try of it
+  // is expected to cost 0.2 ms above the current's, a credit refilled by
+  // 1 % of each 1 ms frame covers one in 20 frames at most. After it
+  // becomes the cheaper, it is kept within trial + 16 x period + 20 frames.
+  AutoConfig c = config();
+  c.budget = 0.02;
+  detail::AutoSchedule s(c, 2);
+  run(s, {1.0, 1.2}, 3000);
+  ASSERT_EQ(s.current(), 0u);
+  const auto ran = run(s, {1.0, 0.5}, c.trial + 16 * c.period + 20 + 1);
+  EXPECT_EQ(s.current(), 1u);
+  EXPECT_EQ(ran.back(), 1u);
+  // A loser whose try's first frame costs more than the whole credit (10 ms) is not tried again.
+  detail::AutoSchedule far(c, 2);
+  run(far, {1.0, 20.0}, 5);
+  ASSERT_EQ(far.current(), 0u);
+  const auto later = run(far, {1.0, 20.0}, 5000);
+  EXPECT_EQ(std::count(later.begin(), later.end(), 1u), 0);
 }
 
 TEST(AutoSchedule, DoesNotAlternateBetweenTwoEqualCandidates) {
@@ -296,7 +368,7 @@ TEST(AutoCuller, SwitchesWhenTheBackendsCostsChange) {
   const Bvh bvh = Bvh::build(scene);
   Options o;
   o.set("auto.candidates", "vfc+chcpp");
-  o.set("auto.period", "5");
+  o.set("auto.period", "1");
   o.set("chcpp.virtual_leaf", "0");
   o.set("chcpp.enter_p_min", "0");  // chcpp keeps querying these always-visible boxes: frames with queries are its
   o.set("chcpp.backoff", "0");
@@ -319,9 +391,16 @@ TEST(AutoCuller, SwitchesWhenTheBackendsCostsChange) {
     }
     return with_queries;
   };
-  (void)fly(10.0, 5.0, 10);                     // queries are expensive here
-  EXPECT_LE(fly(10.0, 5.0, 40), 12) << "auto should mostly run vfc";
-  (void)fly(2.0, 5.0, 60);                      // now querying pays
+  (void)fly(10.0, 5.0, 10);                     // queries are expensive here: the start's round
+  // chcpp is due for a try every 16 frames at most (period 1), each frame
+  // of it 5 ms above vfc's: the budget (10 ms + 1 % of 400 x 5 ms) pays for
+  // six such frames at most (25 without it).
+  EXPECT_LE(fly(10.0, 5.0, 400), 6) << "auto should run vfc but for tries within the budget";
+  // Now querying pays. chcpp's next try is expected to cost 5 ms above
+  // vfc's (its last measure), which the credit covers within 100 frames (it
+  // refills at 1 % of each 5 ms frame): chcpp is kept within 16 x period +
+  // 100 + trial frames.
+  (void)fly(2.0, 5.0, 16 + 100 + 2);
   EXPECT_GE(fly(2.0, 5.0, 40), 30) << "auto should have switched to chcpp";
   EXPECT_EQ(switches, 1u) << "the frames record the switch";
 }

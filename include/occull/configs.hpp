@@ -233,6 +233,11 @@ struct AutoConfig {
   double cut = 1.3;        ///< a try costing above this times the current's lost by far; in [1, 100]
   double skip = 1.5;       ///< vfc is not tried while estimated above this times the current's cost; in [1, 100]
   double smoothing = 0.15; ///< weight of the newest frame in the running cost of the current culler
+  /// Tries after the start's round cost at most this share of the frame
+  /// time over any second of frames (what their frames cost above the
+  /// current culler's predicted cost of them); in [0, 1]. 0: no tries after
+  /// the start's round.
+  double budget = 0.02;
 };
 
 /// Tiled worlds: every tile in the frustum drawn, no queries.

@@ -96,7 +96,32 @@ constexpr double kFar = 8.0;
 AutoSchedule::AutoSchedule(AutoConfig config, std::size_t candidates)
     : config_(std::move(config)), count_(candidates), cost_(candidates, 0.0), estimate_(candidates, 0.0),
       estimated_in_(candidates, 0),
-      losses_(candidates, 0), next_try_(candidates, 0), disabled_(candidates, false), starts_up_(candidates, false) {}
+      losses_(candidates, 0), next_try_(candidates, 0), disabled_(candidates, false), starts_up_(candidates, false),
+      waiting_(candidates, false), credit_ms_(cap_ms()) {}
+
+double AutoSchedule::cap_ms() const { return config_.budget / 2.0 * 1000.0; }
+
+bool AutoSchedule::affordable(std::size_t c) const {
+  if (initial_) return true;  // the start's round is outside the budget
+  if (config_.budget <= 0.0) return false;
+  const double current = cost_[current_];
+  if (current <= 0.0 || ms_per_cost_ <= 0.0) return credit_ms_ >= 0.0;
+  const double expected = cost_[c] > 0.0 ? cost_[c] : config_.cut * current;
+  return credit_ms_ >= std::max(0.0, expected - current) * ms_per_cost_;
+}
+
+void AutoSchedule::pay(double cost, double ms) {
+  if (ms > 0.0 && cost > 0.0) ms_per_cost_ = ms / cost;
+  excess_ms_ = 0.0;
+  if (initial_) return;  // the start's round is outside the budget: the credit stays full
+  credit_ms_ = std::min(cap_ms(), credit_ms_ + config_.budget / 2.0 * std::max(0.0, ms));
+  const double current = cost_[current_];
+  if (!in_trial_ || current <= 0.0 || cost <= 0.0) return;
+  // A frame of a try: what it cost above the current's cost of this frame's content.
+  excess_ms_ = std::max(0.0, ms * (1.0 - current / cost));
+  credit_ms_ -= excess_ms_;
+  spent_ms_ += excess_ms_;
+}
 
 void AutoSchedule::starts_up(std::size_t c) { starts_up_[c] = true; }
 
@@ -214,10 +239,7 @@ std::size_t AutoSchedule::estimated_cheaper(double than) const {
 void AutoSchedule::after_initial(std::size_t c) {
   for (std::size_t n = c + 1; n < count_; ++n) {
     if (disabled_[n]) continue;
-    if (hopeless(n)) {
-      lost(n, 3);
-      continue;
-    }
+    if (hopeless(n)) continue;  // skipped, not lost: checked again after the round
     start_trial(n);
     return;
   }
@@ -235,18 +257,22 @@ void AutoSchedule::after_initial(std::size_t c) {
 }
 
 void AutoSchedule::choose_next() {
-  // Tries due, the one waiting longest first; a hopeless one loses untried.
+  // Tries due, the one waiting longest first. A hopeless one is skipped
+  // (an estimate is no measure: it is checked again next frame, at no
+  // cost), one the budget's credit does not cover waits for it.
+  std::fill(waiting_.begin(), waiting_.end(), false);
   for (;;) {
     std::size_t due = count_;
     for (std::size_t i = 0; i < count_; ++i)
-      if (i != current_ && !disabled_[i] && next_try_[i] <= frame_ && (due == count_ || next_try_[i] < next_try_[due]))
+      if (i != current_ && !disabled_[i] && !waiting_[i] && next_try_[i] <= frame_ &&
+          (due == count_ || next_try_[i] < next_try_[due]))
         due = i;
     if (due == count_) return;
-    if (!hopeless(due)) {
+    if (!hopeless(due) && affordable(due)) {
       start_trial(due);
       return;
     }
-    lost(due, 3);
+    waiting_[due] = true;
   }
 }
 
@@ -260,7 +286,7 @@ void AutoSchedule::unmeasured() {
   if (in_trial_ && trial_frame_ == 0) restarted_ = true;  // the try goes on: its first frame has run
 }
 
-void AutoSchedule::finished(double cost) {
+void AutoSchedule::finished(double cost, double ms) {
   ++frame_;
   switched_ = false;
   if (cold_) {  // every culler's first frame builds its state from nothing: not a measure of it
@@ -268,6 +294,7 @@ void AutoSchedule::finished(double cost) {
     start_trial(running_);
     return;
   }
+  pay(cost, ms);
   if (in_trial_) {
     samples_.push_back(cost);
     ++trial_frame_;
@@ -280,7 +307,9 @@ void AutoSchedule::finished(double cost) {
     const bool far = against > 0.0 && cost > kFar * against && !(starts_up_[running_] && cost_[running_] == 0.0);
     const bool confirmed = trial_frame_ >= 2 || (cost_[running_] > 0.0 && cost <= kSpike * cost_[running_]) || far;
     const bool cut = confirmed && against > 0.0 && lowest > config_.cut * against;
-    if (trial_frame_ >= config_.trial || cut) end_trial();
+    // Out of credit: the credit left would not cover another such frame.
+    const bool spent = !initial_ && excess_ms_ > 0.0 && credit_ms_ < excess_ms_;
+    if (trial_frame_ >= config_.trial || cut || spent) end_trial();
     return;
   }
   // The current culler: a running cost, so it follows the scene; a spike
@@ -538,8 +567,10 @@ class AutoCuller final : public Culler {
     }
     if (after_cut_ > 0)
       schedule_.unmeasured();
-    else
-      schedule_.finished((measured.frame_ms > 0.0 ? measured.frame_ms : own_ms_) / content_);
+    else {
+      const double ms = measured.frame_ms > 0.0 ? measured.frame_ms : own_ms_;
+      schedule_.finished(ms / content_, ms);
+    }
   }
 
   // `to` runs after `from` ran last frame: hands it the visibility `from`
@@ -617,7 +648,10 @@ Registration auto_registration() {
                 "a try costing more than this times the current culler's lost by far (its next try in 4x period "
                 "frames at least)")
           .real("skip", &C::skip, 1.0, 100.0,
-                "vfc is not tried while its estimated cost is above this times the current culler's");
+                "vfc is not tried while its estimated cost is above this times the current culler's")
+          .real("budget", &C::budget, 0.0, 1.0,
+                "tries after the start's round cost at most this share of any second's frame time above the "
+                "current culler's (0: no tries after the start's round)");
   return registered(
       {"auto", "adaptive: runs the cheapest of its candidates (every conservative culler) for this view, learnt "
                "from the measured frame times, with hysteresis"},

@@ -31,7 +31,7 @@ namespace occull::detail {
 /// on llvmpipe, 4-5 ms frames among 1 ms ones, most in a run's first
 /// frames), not the candidate's. The current's
 /// running cost takes each frame at most at twice its value. A try is
-/// skipped (and counts as lost) when the challenger's estimate (estimate();
+/// skipped (no loss: see below) while the challenger's estimate (estimate();
 /// auto gives one for vfc, whose frame is predictable: it draws the
 /// frustum) exceeds `skip` x the current's; an estimate of this frame's
 /// view below (1 - margin) x the current's cost of the same frame (and its
@@ -42,10 +42,26 @@ namespace occull::detail {
 /// candidates of equal cost therefore do not alternate. A challenger that
 /// loses waits period frames for its next try, twice as long after each
 /// further loss, up to 16 x period; a try that cost more than `cut` x the
-/// current's (in the start's round too), or one skipped as hopeless, counts
-/// as three losses (4 x period at least). So after the costs change, the
-/// cheaper candidate is kept within
-/// trial + 16 x period frames.
+/// current's (in the start's round too) counts as three losses (4 x period
+/// at least). A try skipped as hopeless is no loss: the estimate is checked
+/// again every frame, at no cost, and the try runs once it is not.
+///
+/// The budget of tries. After the start's round a try is paid from a
+/// credit, in milliseconds of frame time (finished()'s `ms`): every measured
+/// frame adds budget / 2 x its time, up to budget / 2 x 1000 ms; every
+/// frame of a try takes what it cost above the current's predicted cost of
+/// it (the current's cost x this frame's content). A due try starts only
+/// when the credit covers what its first frame is expected to cost above
+/// the current's (the candidate's last measured cost, or cut x the
+/// current's when never measured), and ends when the credit runs out. So
+/// over any run of frames the tries spend at most budget / 2 x 1000 ms +
+/// budget / 2 x their time: at most `budget` of any second's frame time,
+/// but for the error of the last frame's expectation. The start's round is
+/// outside it (every candidate is tried once: trial frames each at most).
+/// So after the costs change, a challenger that became cheaper is kept
+/// within trial + 16 x period frames once the credit covers its try: a try
+/// expected to cost E ms above the current's waits at most E / (budget / 2
+/// x the frame's ms) frames for it, and never where E is above the cap.
 class AutoSchedule {
  public:
   AutoSchedule(AutoConfig config, std::size_t candidates);
@@ -58,8 +74,10 @@ class AutoSchedule {
   /// Whether the last finished() made a challenger the current.
   [[nodiscard]] bool just_switched() const noexcept { return switched_; }
   /// Reports the cost of the frame just run by next() and chooses the next
-  /// frame's candidate.
-  void finished(double cost);
+  /// frame's candidate. `ms`: the frame's time, ms (the budget's unit);
+  /// without it the cost is taken as the frame's time.
+  void finished(double cost, double ms);
+  void finished(double cost) { finished(cost, cost); }
   /// The frame just run by next() is not a measure (it followed a camera
   /// cut: every temporal culler starts over there): it is not counted; a try
   /// in progress goes on and is judged on its measured frames.
@@ -88,6 +106,10 @@ class AutoSchedule {
   [[nodiscard]] std::uint64_t switches() const noexcept { return switches_; }
   [[nodiscard]] std::uint64_t tries() const noexcept { return tries_; }     ///< tries of challengers run
   [[nodiscard]] double cost(std::size_t c) const { return cost_[c]; }      ///< 0 until measured
+  [[nodiscard]] double credit_ms() const noexcept { return credit_ms_; }     ///< the budget's credit, ms
+  /// What the tries spent above the current's predicted cost since the
+  /// start's round, ms.
+  [[nodiscard]] double spent_ms() const noexcept { return spent_ms_; }
 
  private:
   void start_trial(std::size_t c);
@@ -98,9 +120,12 @@ class AutoSchedule {
   void take_over(std::size_t c, double cost);  // c becomes the current, at this cost
   // the candidate estimated for this frame below `than` x (1 - margin), or count_
   [[nodiscard]] std::size_t estimated_cheaper(double than) const;
-  void lost(std::size_t c, std::uint32_t by = 1);  // c lost a try (or skipped one): its next comes later
+  void lost(std::size_t c, std::uint32_t by = 1);  // c lost a try: its next comes later
   [[nodiscard]] double reference(std::size_t c) const;  // the cost a try of c is measured against
   [[nodiscard]] bool hopeless(std::size_t c) const;  // its estimate skips its try
+  [[nodiscard]] bool affordable(std::size_t c) const;  // the credit covers its try's first frame
+  void pay(double cost, double ms);  // the budget after a measured frame
+  [[nodiscard]] double cap_ms() const;  // the most credit there is
 
   AutoConfig config_;
   std::size_t count_;
@@ -111,6 +136,7 @@ class AutoSchedule {
   std::vector<std::uint64_t> next_try_;
   std::vector<bool> disabled_;
   std::vector<bool> starts_up_;    // see starts_up()
+  std::vector<bool> waiting_;      // due, but not covered by the credit (choose_next)
   std::vector<double> samples_;    // the try's frames
   std::size_t current_ = 0;
   std::size_t running_ = 0;
@@ -123,6 +149,10 @@ class AutoSchedule {
   std::uint64_t frame_ = 0;
   std::uint64_t switches_ = 0;
   std::uint64_t tries_ = 0;
+  double credit_ms_ = 0.0;         // the budget's credit (see the class comment)
+  double spent_ms_ = 0.0;
+  double excess_ms_ = 0.0;         // what the last frame, of a try, cost above the current's
+  double ms_per_cost_ = 0.0;       // the last measured frame's ms per unit of cost (its content)
 };
 
 }  // namespace occull::detail
