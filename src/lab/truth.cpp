@@ -132,9 +132,11 @@ class PixelRays {
       const double x = (c.x / c.w + 1.0) * 0.5 * width_, y = (c.y / c.w + 1.0) * 0.5 * height_;
       x0 = std::min(x0, x), x1 = std::max(x1, x), y0 = std::min(y0, y), y1 = std::max(y1, y);
     }
-    const auto lo = [](double v) { return int(std::max(-1.0, std::floor(v - 0.5) - 1.0)); };
-    return {std::max(0, lo(x0)), std::max(0, lo(y0)), int(std::min(double(width_ - 1), std::ceil(x1) + 1.0)),
-            int(std::min(double(height_ - 1), std::ceil(y1) + 1.0))};
+    // Clamped before the conversion: a corner far off the viewport lies
+    // beyond int's range, where converting is undefined.
+    const auto lo = [](double v, int size) { return int(std::clamp(std::floor(v - 0.5) - 1.0, 0.0, double(size))); };
+    const auto hi = [](double v, int size) { return int(std::clamp(std::ceil(v) + 1.0, -1.0, double(size - 1))); };
+    return {lo(x0, width_), lo(y0, height_), hi(x1, width_), hi(y1, height_)};
   }
 
  private:
