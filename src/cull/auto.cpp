@@ -97,7 +97,7 @@ AutoSchedule::AutoSchedule(AutoConfig config, std::size_t candidates)
     : config_(std::move(config)), count_(candidates), cost_(candidates, 0.0), estimate_(candidates, 0.0),
       estimated_in_(candidates, 0),
       losses_(candidates, 0), next_try_(candidates, 0), disabled_(candidates, false), starts_up_(candidates, false),
-      waiting_(candidates, false), credit_ms_(cap_ms()) {}
+      credit_ms_(cap_ms()) {}
 
 double AutoSchedule::cap_ms() const { return config_.budget / 2.0 * 1000.0; }
 
@@ -110,17 +110,17 @@ bool AutoSchedule::affordable(std::size_t c) const {
   return credit_ms_ >= std::max(0.0, expected - current) * ms_per_cost_;
 }
 
-void AutoSchedule::pay(double cost, double ms) {
+double AutoSchedule::pay(double cost, double ms) {
   if (ms > 0.0 && cost > 0.0) ms_per_cost_ = ms / cost;
-  excess_ms_ = 0.0;
-  if (initial_) return;  // the start's round is outside the budget: the credit stays full
+  if (initial_) return 0.0;  // the start's round is outside the budget: the credit stays full
   credit_ms_ = std::min(cap_ms(), credit_ms_ + config_.budget / 2.0 * std::max(0.0, ms));
   const double current = cost_[current_];
-  if (!in_trial_ || current <= 0.0 || cost <= 0.0) return;
+  if (!in_trial_ || current <= 0.0 || cost <= 0.0) return 0.0;
   // A frame of a try: what it cost above the current's cost of this frame's content.
-  excess_ms_ = std::max(0.0, ms * (1.0 - current / cost));
-  credit_ms_ -= excess_ms_;
-  spent_ms_ += excess_ms_;
+  const double excess = std::max(0.0, ms * (1.0 - current / cost));
+  credit_ms_ -= excess;
+  spent_ms_ += excess;
+  return excess;
 }
 
 void AutoSchedule::starts_up(std::size_t c) { starts_up_[c] = true; }
@@ -257,23 +257,15 @@ void AutoSchedule::after_initial(std::size_t c) {
 }
 
 void AutoSchedule::choose_next() {
-  // Tries due, the one waiting longest first. A hopeless one is skipped
+  // The due try waiting longest that may start. A hopeless one is skipped
   // (an estimate is no measure: it is checked again next frame, at no
   // cost), one the budget's credit does not cover waits for it.
-  std::fill(waiting_.begin(), waiting_.end(), false);
-  for (;;) {
-    std::size_t due = count_;
-    for (std::size_t i = 0; i < count_; ++i)
-      if (i != current_ && !disabled_[i] && !waiting_[i] && next_try_[i] <= frame_ &&
-          (due == count_ || next_try_[i] < next_try_[due]))
-        due = i;
-    if (due == count_) return;
-    if (!hopeless(due) && affordable(due)) {
-      start_trial(due);
-      return;
-    }
-    waiting_[due] = true;
-  }
+  std::size_t due = count_;
+  for (std::size_t i = 0; i < count_; ++i)
+    if (i != current_ && !disabled_[i] && next_try_[i] <= frame_ && (due == count_ || next_try_[i] < next_try_[due]) &&
+        !hopeless(i) && affordable(i))
+      due = i;
+  if (due != count_) start_trial(due);
 }
 
 void AutoSchedule::unmeasured() {
@@ -294,7 +286,7 @@ void AutoSchedule::finished(double cost, double ms) {
     start_trial(running_);
     return;
   }
-  pay(cost, ms);
+  const double excess = pay(cost, ms);
   if (in_trial_) {
     samples_.push_back(cost);
     ++trial_frame_;
@@ -308,7 +300,7 @@ void AutoSchedule::finished(double cost, double ms) {
     const bool confirmed = trial_frame_ >= 2 || (cost_[running_] > 0.0 && cost <= kSpike * cost_[running_]) || far;
     const bool cut = confirmed && against > 0.0 && lowest > config_.cut * against;
     // Out of credit: the credit left would not cover another such frame.
-    const bool spent = !initial_ && excess_ms_ > 0.0 && credit_ms_ < excess_ms_;
+    const bool spent = excess > 0.0 && credit_ms_ < excess;
     if (trial_frame_ >= config_.trial || cut || spent) end_trial();
     return;
   }

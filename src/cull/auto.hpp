@@ -106,7 +106,6 @@ class AutoSchedule {
   [[nodiscard]] std::uint64_t switches() const noexcept { return switches_; }
   [[nodiscard]] std::uint64_t tries() const noexcept { return tries_; }     ///< tries of challengers run
   [[nodiscard]] double cost(std::size_t c) const { return cost_[c]; }      ///< 0 until measured
-  [[nodiscard]] double credit_ms() const noexcept { return credit_ms_; }     ///< the budget's credit, ms
   /// What the tries spent above the current's predicted cost since the
   /// start's round, ms.
   [[nodiscard]] double spent_ms() const noexcept { return spent_ms_; }
@@ -124,7 +123,7 @@ class AutoSchedule {
   [[nodiscard]] double reference(std::size_t c) const;  // the cost a try of c is measured against
   [[nodiscard]] bool hopeless(std::size_t c) const;  // its estimate skips its try
   [[nodiscard]] bool affordable(std::size_t c) const;  // the credit covers its try's first frame
-  void pay(double cost, double ms);  // the budget after a measured frame
+  double pay(double cost, double ms);  // the budget after a measured frame; returns a try frame's excess, ms
   [[nodiscard]] double cap_ms() const;  // the most credit there is
 
   AutoConfig config_;
@@ -136,7 +135,6 @@ class AutoSchedule {
   std::vector<std::uint64_t> next_try_;
   std::vector<bool> disabled_;
   std::vector<bool> starts_up_;    // see starts_up()
-  std::vector<bool> waiting_;      // due, but not covered by the credit (choose_next)
   std::vector<double> samples_;    // the try's frames
   std::size_t current_ = 0;
   std::size_t running_ = 0;
@@ -151,7 +149,6 @@ class AutoSchedule {
   std::uint64_t tries_ = 0;
   double credit_ms_ = 0.0;         // the budget's credit (see the class comment)
   double spent_ms_ = 0.0;
-  double excess_ms_ = 0.0;         // what the last frame, of a try, cost above the current's
   double ms_per_cost_ = 0.0;       // the last measured frame's ms per unit of cost (its content)
 };
 
