@@ -522,6 +522,29 @@ TEST(Bench, SplitScreenRunsEachViewOnItsPathAndReportsTheFrameAndEachView) {
   EXPECT_THROW((void)run_bench(c), InputError);
 }
 
+// auto's warm-up warms each of its candidates too: spread over the path, the
+// warm-up frames are camera cuts to auto, whose schedule stays on its first
+// candidate over them, and the others would pay the driver's one-off costs
+// (shader variants compiled at first use) in their first timed frame.
+TEST(Bench, AutosWarmUpWarmsEachOfItsCandidatesAsTheirOwnRunsWould) {
+  BenchConfig c;
+  c.scene = kSmallCity;
+  c.algorithms = {"vfc", "auto"};
+  c.frames = 2;
+  c.warmup = 3;
+  c.width = 128;
+  c.height = 54;
+  std::map<std::string, int> warm;
+  const BenchResult r = run_bench(c, [&](std::string_view label, int, int, bool warmup) {
+    if (warmup) ++warm[std::string(label)];
+  });
+  ASSERT_EQ(r.summaries.size(), 2u);
+  const std::size_t candidates = r.runs[1].choices.size();
+  ASSERT_GE(candidates, 2u);
+  EXPECT_EQ(warm["vfc"], 3);
+  EXPECT_EQ(warm["auto"], int(3 * (1 + candidates))) << "auto's " << candidates << " candidates not warmed up";
+}
+
 // The lab's watchdog: a step that does not finish is named once its time
 // is up; a step that finishes is never reported. (No timing is asserted: the
 // first waits as long as the watchdog takes, the second uses a time no test

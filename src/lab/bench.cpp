@@ -161,6 +161,15 @@ struct ViewCullers {
 
 // One algorithm over the views' frames (one view: a plain run): the warm-up
 // frames with throw-away cullers, then the timed frames with fresh ones.
+// The warm-up takes the one-off costs of the process out of the timed
+// frames (the driver compiling its shader variants at their first use, pages
+// touched for the first time), not the culler's own start-up: the timed
+// cullers are new. An algorithm that runs others (auto: Culler::choices())
+// has each of them warmed up as its own run would be, after its own warm-up:
+// spread over the path, the warm-up frames are camera cuts to auto, whose
+// schedule does not move on over them, so its candidates would otherwise pay
+// those costs at their first timed frame (wrackdm17 at 320x180: CHC's first
+// 8-9 ms, hiz's 15-16 ms, frames of 1-2 ms).
 // Appends the run of whole frames and, with more than one view, one run per
 // view ("NAME [view K]").
 void run_algorithm(Session& session, const std::string& name, const BenchConfig& config,
@@ -169,8 +178,9 @@ void run_algorithm(Session& session, const std::string& name, const BenchConfig&
   const int views = int(paths.size());
   std::vector<const std::vector<FrameTruth>*> truth_of;
   for (int k = 0; k < views; ++k) truth_of.push_back(config.verify ? &truths[std::size_t(k)] : nullptr);
-  {
-    ViewCullers warm(session, name, config.options, views);
+  // Warms `spec` up; returns its choices.
+  const auto warm_up = [&](const std::string& spec) {
+    ViewCullers warm(session, spec, config.options, views);
     const Views v = warm.over(paths, truth_of);
     for (int w = 0; w < config.warmup; ++w) {
       const int f = warmup_frame(config, w);
@@ -180,8 +190,11 @@ void run_algorithm(Session& session, const std::string& name, const BenchConfig&
                                      truth_of[std::size_t(k)]);
       if (progress) progress(label, w, config.warmup, true);
     }
+    std::vector<std::string> choices = warm.view(0).choices();
     warm.release(session, views);
-  }
+    return choices;
+  };
+  for (const std::string& choice : warm_up(name)) (void)warm_up(choice);
   ViewCullers cullers(session, name, config.options, views);
   std::vector<AlgorithmRun> runs = run_frames(session, name, cullers.over(paths, truth_of), config.frames,
                                               [&](std::string_view, int k, int n, bool w) {
