@@ -168,8 +168,8 @@ struct ViewCullers {
 // has each of them warmed up as its own run would be, after its own warm-up:
 // spread over the path, the warm-up frames are camera cuts to auto, whose
 // schedule does not move on over them, so its candidates would otherwise pay
-// those costs at their first timed frame (wrackdm17 at 320x180: CHC's first
-// 8-9 ms, hiz's 15-16 ms, frames of 1-2 ms).
+// those costs at their first timed frame (wrackdm17 at 320x180, three runs:
+// CHC's first 8-11 ms, hiz's 15-21 ms, among frames of 1-2 ms).
 // Appends the run of whole frames and, with more than one view, one run per
 // view ("NAME [view K]").
 void run_algorithm(Session& session, const std::string& name, const BenchConfig& config,
