@@ -20,6 +20,10 @@ packages=(
   libopenscenegraph-dev openscenegraph
   # occull view: a window (GLFW) with Dear ImGui; tested under a virtual X server
   libglfw3-dev libimgui-dev xvfb xauth
+  # occull::vk, the Vulkan renderer: Mesa's lavapipe (a Vulkan 1.3 device without a GPU), the
+  # loader and headers, volk (loads the Vulkan entry points per device), glslc (the shaders are
+  # compiled to SPIR-V at build time) and the Khronos validation layers (its tests fail on any error)
+  mesa-vulkan-drivers libvulkan-dev libvulkan-volk-dev glslc vulkan-validationlayers
   # tests and benchmarks
   libgtest-dev libgmock-dev
 )

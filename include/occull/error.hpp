@@ -34,6 +34,24 @@ class GlUnavailable : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+/// The platform cannot run the Vulkan renderer (occull::vk): no Vulkan
+/// loader, no device, or a device without what occull needs (a Vulkan 1.2
+/// device with precise occlusion queries, depth clamping, independent blending
+/// and host query reset). The message names what is missing and the package
+/// that provides it. Tools map it to exit code 3, as GlUnavailable.
+class VulkanUnavailable : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+/// A Vulkan call failed (its VkResult is named), a validation layer reported
+/// an error (vk::Context with validation on), or a shader module was
+/// refused. A bug in occull or in the driver. Tools map it to exit code 1.
+class VulkanError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
 /// A run-time invariant of the measuring instrument failed (e.g. the ground
 /// truth is empty while the frame shows objects): nothing it measured can be
 /// trusted, so the run stops. The message names the invariant, the scene,

@@ -1,0 +1,131 @@
+// The Vulkan renderer (occull::vk) on lavapipe, with the Khronos validation
+// layer on in every test (and any error it reports fails the test): the
+// same visible sets as the OpenGL renderer, conservative cullers that miss
+// nothing through it, and the cost of reading results mid-frame counted.
+#include "occull/bvh.hpp"
+#include "occull/culler.hpp"
+#include "occull/error.hpp"
+#include "occull/gl/context.hpp"
+#include "occull/gl/renderer.hpp"
+#include "occull/scenes.hpp"
+#include "occull/vk/context.hpp"
+#include "occull/vk/renderer.hpp"
+
+#include "vk/vk.hpp"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <map>
+#include <set>
+
+namespace occull {
+namespace {
+
+constexpr int kWidth = 160, kHeight = 90;
+
+// A validated Vulkan context for one test; fails the test on any error
+// the layer reported over its life.
+class VulkanTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    vk::ContextOptions o;
+    o.validation = true;
+    context = vk::Context::create(o);
+  }
+  void TearDown() override {
+    EXPECT_EQ(context->validation_errors(), 0) << context->first_validation_error();
+  }
+  std::unique_ptr<vk::Context> context;
+};
+
+std::vector<ObjectId> all_objects(const Scene& scene) {
+  std::vector<ObjectId> ids;
+  for (ObjectId id = 0; id < scene.objects().size(); ++id)
+    if (!scene.object(id).removed) ids.push_back(id);
+  return ids;
+}
+
+std::vector<View> path_views(const SceneBundle& b, int frames) {
+  std::vector<View> views;
+  const CameraPath& path = b.paths.front();
+  for (int k = 0; k < frames; ++k)
+    views.push_back(make_view(path.sample(path.frame_time(k, frames)), b.lens, kWidth, kHeight));
+  return views;
+}
+
+TEST_F(VulkanTest, ContextNamesItsDeviceAndFeatures) {
+  const vk::DeviceInfo& info = context->info();
+  EXPECT_FALSE(info.name.empty());
+  EXPECT_FALSE(info.api_version.empty());
+  EXPECT_TRUE(info.validation);
+  std::printf("device: %s | Vulkan %s | %s | conditional rendering %d | timestamps %d bits\n", info.name.c_str(),
+              info.api_version.c_str(), info.driver.c_str(), int(info.conditional_rendering), info.timestamp_bits);
+}
+
+// The check of every other test: the layer's reports are counted, and
+// check() turns them into VulkanError. Broken on purpose: a buffer of size 0.
+TEST_F(VulkanTest, ValidationErrorsAreCountedAndThrown) {
+  const auto& h = context->handles();
+  VkBufferCreateInfo info{VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO};
+  info.size = 0;  // VUID-VkBufferCreateInfo-size-00912
+  info.usage = VK_BUFFER_USAGE_VERTEX_BUFFER_BIT;
+  VkBuffer buffer = VK_NULL_HANDLE;
+  const VkResult r = vkCreateBuffer(h.device, &info, nullptr, &buffer);
+  if (r == VK_SUCCESS && buffer) vkDestroyBuffer(h.device, buffer, nullptr);
+  EXPECT_GE(context->validation_errors(), 1);
+  EXPECT_THROW(context->check("a buffer of size 0"), VulkanError);
+  EXPECT_NO_THROW(context->check("nothing since"));
+  // This test's error was expected: the fixture's check is for the others.
+  context.reset();
+  vk::ContextOptions o;
+  o.validation = true;
+  context = vk::Context::create(o);
+}
+
+// The same frames through OpenGL and Vulkan show the same objects, up to
+// the rasterisers' tie-breaking at pixel edges: an object seen by one only
+// covers at most a few pixels in the other's image.
+TEST_F(VulkanTest, VisibleSetsEqualOpenGlsUpToPixelEdges) {
+  for (const char* spec : {"city:blocks=4", "field", "adversarial"}) {
+    SCOPED_TRACE(spec);
+    const SceneBundle b = make_scene(spec);
+    const auto ids = all_objects(b.scene);
+    auto gl_context = gl::Context::create();
+    gl::RendererOptions go;
+    go.width = kWidth;
+    go.height = kHeight;
+    gl::Renderer glr(b.scene, go);
+    vk::RendererOptions vo;
+    vo.width = kWidth;
+    vo.height = kHeight;
+    vk::Renderer vkr(*context, b.scene, vo);
+    std::size_t objects = 0, only_one = 0, pixels = 0, pixels_differ = 0;
+    for (const View& view : path_views(b, 8)) {
+      std::map<ObjectId, std::uint32_t> g, v;
+      for (const auto& p : glr.visible_pixels(view, ids)) g[p.id] = p.pixels;
+      for (const auto& p : vkr.visible_pixels(view, ids)) v[p.id] = p.pixels;
+      ASSERT_FALSE(g.empty());
+      std::set<ObjectId> both;
+      for (const auto& [id, n] : g) both.insert(id);
+      for (const auto& [id, n] : v) both.insert(id);
+      for (ObjectId id : both) {
+        const std::uint32_t a = g.count(id) ? g[id] : 0, c = v.count(id) ? v[id] : 0;
+        ++objects;
+        pixels += std::max(a, c);
+        pixels_differ += a > c ? a - c : c - a;
+        if ((a == 0) != (c == 0)) {
+          ++only_one;
+          EXPECT_LE(std::max(a, c), 4u) << "object " << id << ": " << a << " pixels in OpenGL, " << c << " in Vulkan";
+        }
+      }
+    }
+    std::printf("%s: %zu objects seen, %zu by one renderer only; %zu of %zu pixels differ\n", spec, objects, only_one,
+                pixels_differ, pixels);
+    EXPECT_LE(double(pixels_differ), 0.01 * double(pixels));
+  }
+}
+
+}  // namespace
+}  // namespace occull
