@@ -28,6 +28,9 @@ inline constexpr const char* kMallocHelp =
 inline constexpr const char* kGlDebugHelp =
     "GL debug contexts: the driver checks every call, and a failing one stops the run with exit 1, "
     "naming the call and its stack (slower: not for timings)";
+inline constexpr const char* kApiHelp =
+    "graphics API the frames render through: gl (OpenGL 4.5, the reference renderer) or vulkan (Vulkan "
+    "1.2 on the first device: lavapipe without a GPU; --gl-debug turns its validation layer on)";
 inline constexpr const char* kDepthHelp =
     "depth convention of the views: standard (OpenGL's [-1, 1]) or reversed (reversed-Z in [0, 1] with an "
     "infinite far plane, as engines render); the truth and the verifier follow it";

@@ -42,6 +42,8 @@ int cmd_osg(const OsgArgs& a) {
                  a.export_file.c_str());
     return 0;
   }
+  if (occull::parse_api(r.api) != occull::Api::gl)
+    throw occull::InputError("--api vulkan: occull osg renders through OpenSceneGraph, which draws with OpenGL");
   osgOccull::OsgBenchConfig c;
   c.scene = r.scene;
   c.file = a.file;

@@ -30,6 +30,7 @@ struct RenderArgs {
   std::string view = "color";
   std::vector<std::string> opts;
   bool gl_debug = false;
+  std::string api = "gl";
   std::string depth = "standard";
 };
 
@@ -86,7 +87,7 @@ int cmd_render(const RenderArgs& a) {
     throw occull::InputError("--fps and --start must be numbers >= 0");
   occull::gl::ContextOptions copts;
   copts.debug = a.gl_debug;
-  occull::Session session(a.scene, ropts, {}, copts);
+  occull::Session session(a.scene, ropts, {}, copts, occull::parse_api(a.api));
   session.set_sampling({a.fps, a.start});
   session.set_depth(occull::parse_depth_mode(a.depth));
   const auto& path = session.path(a.path);
@@ -114,7 +115,7 @@ int cmd_render(const RenderArgs& a) {
     const occull::FrameStats stats =
         session.run_frame(*culler, frame_view, session.frame_time(path, k, a.frames), k >= first ? &log : nullptr);
     if (k < first) continue;
-    std::vector<std::uint8_t> pixels = session.renderer().read_rgba();
+    std::vector<std::uint8_t> pixels = session.render_device().read_rgba();
     std::string legend;
     if (painter) {
       const auto frame_objects = session.recording().objects();
@@ -182,6 +183,7 @@ Command add_render(CLI::App& app) {
   r->add_option("--view", a->view, debug_view_help())->capture_default_str();
   r->add_option("--opt", a->opts, "algorithm option algo.key=value (repeatable)");
   r->add_flag("--gl-debug", a->gl_debug, kGlDebugHelp);
+  r->add_option("--api", a->api, kApiHelp)->capture_default_str();
   r->add_option("--depth", a->depth, kDepthHelp)->capture_default_str();
   return [a] { return cmd_render(*a); };
 }

@@ -58,6 +58,7 @@ void add_run_options(CLI::App* cmd, BenchArgs& a, const std::string& per) {
   cmd->add_option("--json", a.json, "write the results as JSON to this file");
   cmd->add_option("--malloc", a.malloc_policy, kMallocHelp)->capture_default_str();
   cmd->add_flag("--gl-debug", a.gl_debug, kGlDebugHelp);
+  cmd->add_option("--api", a.api, kApiHelp)->capture_default_str();
   cmd->add_option("--stall-guard", a.stall_guard,
                   "milliseconds a culler waits for a query result before taking it as visible, as engines "
                   "guard against a driver that never answers (0: wait; counted as stalled per frame)")
@@ -94,6 +95,7 @@ occull::BenchConfig bench_config(const BenchArgs& a) {
   c.depth = occull::parse_depth_mode(a.depth);
   c.engine_moves = a.engine_moves;
   c.gl_debug = a.gl_debug;
+  c.api = occull::parse_api(a.api);
   c.stall_guard_ms = a.stall_guard;
   c.watchdog_s = a.watchdog;
   c.repeat = a.repeat;

@@ -44,6 +44,7 @@ struct BenchArgs {
   std::string suite;
   int views = 1;
   bool gl_debug = false;
+  std::string api = "gl";
   double stall_guard = 0.0;
   double watchdog = occull::Session::kWatchdogSeconds;
 };

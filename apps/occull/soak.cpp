@@ -29,6 +29,7 @@ struct SoakArgs {
   // mark, which a rare peak of the driver's memory raises without a leak).
   std::string malloc_policy = "system";
   bool gl_debug = false;
+  std::string api = "gl";
   double stall_guard = 0.0;
   double watchdog = occull::Session::kWatchdogSeconds;
 };
@@ -49,6 +50,7 @@ int cmd_soak(const SoakArgs& a) {
   c.renderer.width = size.width;
   c.renderer.height = size.height;
   c.context.debug = a.gl_debug;
+  c.api = occull::parse_api(a.api);
   c.options = parse_options(a.opts);
   c.stall_guard_ms = a.stall_guard;
   c.watchdog_s = a.watchdog;
@@ -97,6 +99,7 @@ Command add_soak(CLI::App& app) {
                                             "the heap's high-water mark")
       ->capture_default_str();
   so->add_flag("--gl-debug", a->gl_debug, kGlDebugHelp);
+  so->add_option("--api", a->api, kApiHelp)->capture_default_str();
   so->add_option("--stall-guard", a->stall_guard,
                  "milliseconds a culler waits for a query result before taking it as visible (0: wait)")
       ->capture_default_str();

@@ -39,7 +39,8 @@ struct BenchConfig {
   double engine_moves = 0.0;              ///< fraction of static objects the engine moves each frame (Session::set_engine_moves)
   BvhOptions bvh;                         ///< how the scene's hierarchy is built
   bool model = false;                     ///< also predict each frame with the NOHC cost model
-  bool gl_debug = false;                  ///< GL debug contexts: a failing GL call stops the run (gl::ContextOptions)
+  bool gl_debug = false;                  ///< GL debug contexts (Vulkan: the validation layer): a failing call stops the run
+  Api api = Api::gl;                      ///< the graphics API frames render through (occull/render_device.hpp)
   double stall_guard_ms = 0.0;            ///< > 0: results not there within this time count as visible (StallGuard)
   double watchdog_s = 300.0;              ///< a frame running longer stops the process, exit 1 (Session::set_watchdog; 0: off)
   std::string allocator;                  ///< the process's allocator policy, as the report names it (apply_allocator_policy)

@@ -22,6 +22,7 @@
 #include "occull/culler.hpp"
 #include "occull/frame_log.hpp"
 #include "occull/recording_backend.hpp"
+#include "occull/render_device.hpp"
 #include "occull/gl/context.hpp"
 #include "occull/gl/renderer.hpp"
 #include "occull/scenes.hpp"
@@ -183,18 +184,20 @@ class MissRuns {
 class Session {
  public:
   /// Builds the scene from `scene_spec` (throws InputError) and its BVH,
-  /// then creates the GL context (throws GlUnavailable) and the renderer.
+  /// then creates the context and the renderer of `api` (occull/render_device.hpp:
+  /// throws GlUnavailable or VulkanUnavailable; InputError for an option
+  /// the API does not have).
   Session(std::string_view scene_spec, const gl::RendererOptions& renderer_options,
-          const BvhOptions& bvh_options = {}, const gl::ContextOptions& context_options = {});
+          const BvhOptions& bvh_options = {}, const gl::ContextOptions& context_options = {}, Api api = Api::gl);
   /// The same over a scene made elsewhere (a model converted by its
   /// owner: `occull osg --file`), named `name` in messages and reports.
   Session(std::string name, SceneBundle bundle, const gl::RendererOptions& renderer_options,
-          const BvhOptions& bvh_options = {}, const gl::ContextOptions& context_options = {});
+          const BvhOptions& bvh_options = {}, const gl::ContextOptions& context_options = {}, Api api = Api::gl);
   ~Session();
   Session(const Session&) = delete;
   Session& operator=(const Session&) = delete;
 
-  /// Replaces the GL context and the renderer by fresh ones, so one
+  /// Replaces the context and the renderer by fresh ones, so one
   /// algorithm's run cannot leave driver state that slows the next (seen on
   /// llvmpipe: after `perobject`'s thousands of small flushes per frame,
   /// chc/chcpp in the same context ran 10-20% slower for the rest of the
@@ -382,9 +385,14 @@ class Session {
   /// the scene had when it was made.
   [[nodiscard]] Scene& scene() noexcept { return bundle_.scene; }
   [[nodiscard]] SceneIndex index() const noexcept { return {bundle_.scene, bvh_, bundle_.world.get()}; }
-  [[nodiscard]] gl::Renderer& renderer() noexcept { return *renderer_; }
-  [[nodiscard]] gl::Context& context() noexcept { return *context_; }
-  [[nodiscard]] const gl::DeviceInfo& device() const noexcept { return device_; }
+  /// The renderer the session draws with, whichever API.
+  [[nodiscard]] RenderDevice& render_device() noexcept { return *device_; }
+  [[nodiscard]] Api api() const noexcept { return device_->api(); }
+  /// The OpenGL renderer and context (occull view, occull osg). Throw
+  /// UsageError in a session of another API.
+  [[nodiscard]] gl::Renderer& renderer();
+  [[nodiscard]] gl::Context& context();
+  [[nodiscard]] const gl::DeviceInfo& device() const noexcept { return device_->info(); }
   [[nodiscard]] double scene_build_ms() const noexcept { return scene_build_ms_; }
   [[nodiscard]] double bvh_build_ms() const noexcept { return bvh_build_ms_; }
   [[nodiscard]] const Bvh& bvh() const noexcept { return bvh_; }
@@ -413,12 +421,10 @@ class Session {
   // The scene at path time `time_s`: Motions, then the engine's moves.
   void advance_scene(double time_s);
   Bvh bvh_;
-  std::unique_ptr<gl::Context> retired_;  // the context reset_renderer() replaced last, idle (see there)
-  std::unique_ptr<gl::Context> context_;
-  gl::DeviceInfo device_;
   gl::RendererOptions renderer_options_;
   gl::ContextOptions context_options_;
-  std::unique_ptr<gl::Renderer> renderer_;
+  Api api_ = Api::gl;
+  std::unique_ptr<RenderDevice> device_;  // the context and the renderer
   double stall_guard_ms_ = 0.0;
   // The backend chain of culler frames: renderer_ <- recorder_ (what the
   // frame drew and queried, for verification and the cost model) <- guard_
@@ -427,7 +433,7 @@ class Session {
   std::unique_ptr<RecordingBackend> recorder_;
   std::unique_ptr<StallGuard> guard_;
   void wrap_renderer();  // (re)builds recorder_ and guard_ over renderer_
-  void start(const gl::RendererOptions& renderer_options, const BvhOptions& bvh_options);  // BVH, context, renderer
+  void start(const gl::RendererOptions& renderer_options, const BvhOptions& bvh_options);  // BVH, device
   std::unique_ptr<LoggingBackend> logger_;  // over backend(), for logged frames; goes before both
   std::unique_ptr<detail::Watchdog> watchdog_;
   std::optional<HardwareProfile> profile_;

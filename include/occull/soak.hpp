@@ -27,6 +27,7 @@ struct SoakConfig {
   double fps = 30.0;             ///< frame k is at k / fps seconds, the path's time modulo its duration; > 0
   gl::RendererOptions renderer;  ///< render size and query setup
   gl::ContextOptions context;    ///< e.g. debug output (--gl-debug)
+  Api api = Api::gl;             ///< the graphics API frames render through (--api)
   Options options;               ///< algorithm options
   double stall_guard_ms = 0.0;   ///< Session::set_stall_guard
   double watchdog_s = Session::kWatchdogSeconds;

@@ -251,7 +251,7 @@ BenchResult run_bench(const BenchConfig& config, const ProgressFn& progress) {
     throw InputError(fmt::format("--start {}: must be a number of seconds >= 0", config.sampling.start_s));
   gl::ContextOptions copts;
   copts.debug = config.gl_debug;
-  Session session(config.scene, ropts, config.bvh, copts);
+  Session session(config.scene, ropts, config.bvh, copts, config.api);
   session.set_depth(config.depth);
   session.set_engine_moves(config.engine_moves);
   session.set_fault_hooks(config.hooks);

@@ -43,15 +43,15 @@ SceneBundle timed_make_scene(std::string_view spec, double& ms) {
 
 // The scene first: a bad spec is reported before any GL work.
 Session::Session(std::string_view scene_spec, const gl::RendererOptions& renderer_options,
-                 const BvhOptions& bvh_options, const gl::ContextOptions& context_options)
+                 const BvhOptions& bvh_options, const gl::ContextOptions& context_options, Api api)
     : scene_spec_(scene_spec), bundle_(timed_make_scene(scene_spec, scene_build_ms_)),
-      context_options_(context_options) {
+      context_options_(context_options), api_(api) {
   start(renderer_options, bvh_options);
 }
 
 Session::Session(std::string name, SceneBundle bundle, const gl::RendererOptions& renderer_options,
-                 const BvhOptions& bvh_options, const gl::ContextOptions& context_options)
-    : scene_spec_(std::move(name)), bundle_(std::move(bundle)), context_options_(context_options) {
+                 const BvhOptions& bvh_options, const gl::ContextOptions& context_options, Api api)
+    : scene_spec_(std::move(name)), bundle_(std::move(bundle)), context_options_(context_options), api_(api) {
   start(renderer_options, bvh_options);
 }
 
@@ -73,10 +73,8 @@ void Session::start(const gl::RendererOptions& renderer_options, const BvhOption
                                  "placed tiles covers (occull::TiledWorld::kMaxAspect)",
                                  scene_spec_, renderer_options.width, renderer_options.height,
                                  TiledWorld::kMaxAspect));
-  context_ = gl::Context::create(context_options_);
-  device_ = context_->info();
   renderer_options_ = renderer_options;
-  renderer_ = std::make_unique<gl::Renderer>(bundle_.scene, renderer_options);
+  device_ = make_render_device(api_, bundle_.scene, renderer_options, context_options_);
   wrap_renderer();
   set_watchdog(kWatchdogSeconds);
 }
@@ -84,7 +82,7 @@ void Session::start(const gl::RendererOptions& renderer_options, const BvhOption
 void Session::wrap_renderer() {
   logger_.reset();  // it wraps what backend() was
   guard_.reset();   // reads the queries it gave up on, through the recorder
-  recorder_ = std::make_unique<RecordingBackend>(*renderer_, bundle_.scene);
+  recorder_ = std::make_unique<RecordingBackend>(device_->backend(), bundle_.scene);
   guard_ = stall_guard_ms_ > 0.0 ? std::make_unique<StallGuard>(*recorder_, stall_guard_ms_) : nullptr;
 }
 
@@ -110,21 +108,27 @@ void Session::reset_renderer() {
   logger_.reset();
   guard_.reset();
   recorder_.reset();
-  renderer_.reset();
-  retired_.reset();  // idle since the previous replacement
-  retired_ = std::move(context_);
-  context_ = gl::Context::create(context_options_);
-  renderer_ = std::make_unique<gl::Renderer>(bundle_.scene, renderer_options_);
+  device_->reset();
   wrap_renderer();
+}
+
+gl::Renderer& Session::renderer() {
+  if (!device_->gl_renderer())
+    throw UsageError(fmt::format("Session::renderer: the session renders through {}, not OpenGL", api_name(api())));
+  return *device_->gl_renderer();
+}
+
+gl::Context& Session::context() {
+  if (!device_->gl_context())
+    throw UsageError(fmt::format("Session::context: the session renders through {}, not OpenGL", api_name(api())));
+  return *device_->gl_context();
 }
 
 Session::~Session() {
   logger_.reset();
   guard_.reset();     // reads the queries it gave up on
   recorder_.reset();
-  renderer_.reset();  // GL objects go before the context
-  context_.reset();
-  retired_.reset();
+  device_.reset();
 }
 
 const CameraPath& Session::path(std::string_view name) {
@@ -153,7 +157,7 @@ View Session::view_of(CameraPose pose) {
     move_origin(origin_for(pose));
     pose.position = placed(pose.position);
   }
-  return make_view(pose, bundle_.lens, renderer_->width(), renderer_->height());
+  return make_view(pose, bundle_.lens, device_->width(), device_->height());
 }
 
 void Session::set_origin_grid(double metres) {
@@ -192,7 +196,7 @@ FrameStats Session::run_frame(Culler& culler, const View& view, double time_s, F
   const ProcessUsage u0 = process_usage();
   const auto t0 = Clock::now();
   if (!bundle_.world) bvh_.refit(bundle_.scene);
-  renderer_->begin_frame(view);
+  device_->begin_frame(view);
   recorder_->start_frame();
   if (log && !logger_) logger_ = std::make_unique<LoggingBackend>(this->backend());
   if (logger_) logger_->log_into(log);
@@ -202,10 +206,10 @@ FrameStats Session::run_frame(Culler& culler, const View& view, double time_s, F
   FrameStats s;
   copy_culler_counters(result, culler, s);
   if (logger_) logger_->log_into(nullptr);  // `log` is this frame's only
-  context_->check("a culler's frame");  // before end_frame's own glGetError, which knows less
-  s.gpu_ms = renderer_->end_frame();
+  device_->check("a culler's frame");  // before end_frame's own glGetError, which knows less
+  s.gpu_ms = device_->end_frame();
   const auto t1 = Clock::now();
-  recorder_->finish_frame([this](QueryId q) { return renderer_->unread_result(q); });
+  recorder_->finish_frame([this](QueryId q) { return device_->unread_result(q); });
   const ProcessUsage u1 = process_usage();
   const BackendStats d = backend.stats() - before;
   s.minor_faults = u1.minor_faults - u0.minor_faults;
@@ -213,7 +217,7 @@ FrameStats Session::run_frame(Culler& culler, const View& view, double time_s, F
   s.kernel_ms = u1.kernel_ms - u0.kernel_ms;
   s.frame_ms = ms_between(t0, t1);
   copy_backend_counters(d, s);
-  context_->check("the end of a frame");
+  device_->check("the end of a frame");
   culler.frame_finished(measure_of(s));
   return s;
 }
@@ -255,7 +259,7 @@ void Session::release(Culler& culler) { culler.release(backend()); }
 
 void Session::check_queries_returned(std::string_view who) const {
   const std::size_t abandoned = guard_ ? guard_->abandoned() : 0;
-  const std::size_t in_flight = renderer_->queries_in_flight();
+  const std::size_t in_flight = device_->queries_in_flight();
   if (in_flight > abandoned)
     detail::invariant_violated({scene_spec_, std::string(who), 0}, "queries-returned",
                                fmt::format("{} queries still in flight after the run's cullers were released ({} of "
@@ -285,7 +289,7 @@ CullerContext Session::culler_context(const std::function<void(const std::string
   return context;
 }
 
-std::string Session::renderer_key() const { return device_.renderer + " | " + device_.version; }
+std::string Session::renderer_key() const { return device().renderer + " | " + device().version; }
 
 std::string Session::hardware_profile_path() const { return default_profile_path(renderer_key()); }
 
@@ -294,12 +298,20 @@ const HardwareProfile& Session::hardware_profile(const std::function<void(const 
   const std::string path = hardware_profile_path();
   profile_ = load_profile(path);
   if (profile_ && profile_->renderer == renderer_key()) return *profile_;
-  if (progress) progress("calibrating the hardware cost model (a few seconds)");
+  // The calibration draws through OpenGL; a Vulkan session makes a context
+  // for it (on the same machine: the same driver's rasteriser) while it runs.
+  std::unique_ptr<gl::Context> calibration_context;
+  if (api() != Api::gl) calibration_context = gl::Context::create(context_options_);
+  if (progress)
+    progress(api() == Api::gl ? "calibrating the hardware cost model (a few seconds)"
+                              : "calibrating the hardware cost model through OpenGL (a few seconds; no Vulkan "
+                                "calibration yet)");
   gl::CalibrationOptions co;
   co.repeats = 3;  // a first-use calibration stays within a few seconds
-  co.width = renderer_->width();
-  co.height = renderer_->height();
+  co.width = device_->width();
+  co.height = device_->height();
   gl::CalibrationResult cal = gl::calibrate(co, progress);
+  calibration_context.reset();
   cal.profile.renderer = renderer_key();
   save_profile(cal.profile, path);
   profile_ = cal.profile;
@@ -354,7 +366,7 @@ FrameStats Session::run_path_frame(Culler& culler, const CameraPath& path, int k
 
 MemorySample Session::memory_sample(int frame) const {
   const MemoryUsage m = memory_usage();
-  return {frame, double(m.resident_bytes) / (1 << 20), double(renderer_->resources().buffer_bytes) / (1 << 20)};
+  return {frame, double(m.resident_bytes) / (1 << 20), double(device_->resources().buffer_bytes) / (1 << 20)};
 }
 
 std::string Session::describe_object(ObjectId id) const {

@@ -75,7 +75,7 @@ void soak_one(Session& session, SoakRun& run, const SoakConfig& c, const CameraP
     w.resident_bytes = m.resident_bytes;
     w.heap_held_bytes = m.heap_held_bytes;
     w.heap_bytes = m.heap_bytes;
-    w.gl = session.renderer().resources();
+    w.gl = session.render_device().resources();
     run.windows.push_back(w);
     if (live) *live << soak_row(w) << std::flush;
     ms.clear();
@@ -120,7 +120,7 @@ void judge_soak_run(SoakRun& run, double tolerance) {
 SoakResult run_soak(const SoakConfig& config, const SoakProgress& progress, std::ostream* live) {
   check(config);
   for (const auto& name : config.algorithms) (void)parse_algorithm_spec(name, config.options);
-  Session session(config.scene, config.renderer, {}, config.context);
+  Session session(config.scene, config.renderer, {}, config.context, config.api);
   session.set_watchdog(config.watchdog_s);
   std::string path_name = config.path;
   if (path_name.empty())

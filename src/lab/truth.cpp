@@ -233,7 +233,7 @@ FrameTruth Session::truth_of(const View& view, const detail::FrameLabel& where) 
 
   FrameTruth t;
   gl::Renderer::PassImages images;
-  t.visible = renderer_->visible_pixels(view, in_frustum, &images);
+  t.visible = device_->visible_pixels(view, in_frustum, &images);
   if (hooks_ && hooks_->truth_images) hooks_->truth_images(t.visible, images);
   // The full scene, for comparison: every opaque object left out of the
   // truth pass, drawn over its depth, must not pass a single sample.
@@ -241,9 +241,9 @@ FrameTruth Session::truth_of(const View& view, const detail::FrameLabel& where) 
   for (ObjectId id : in_frustum) drawn[id] = 1;
   for (ObjectId id = 0; id < objects.size(); ++id)
     if (!drawn[id] && scene.alive(id) && !scene.material(objects[id].material).translucent) outside.push_back(id);
-  const std::uint64_t outside_samples = renderer_->samples_in_front(view, outside);
+  const std::uint64_t outside_samples = device_->samples_in_front(view, outside);
 
-  context_->check("the ground truth");
+  device_->check("the ground truth");
   std::sort(in_frustum.begin(), in_frustum.end());
   detail::check_truth_in_frustum(where, t.visible, in_frustum);
   detail::check_truth_covers_full_render(where, images.ids, images.depth, outside_samples);
@@ -252,10 +252,10 @@ FrameTruth Session::truth_of(const View& view, const detail::FrameLabel& where) 
                                                        renderer_options_.cull_backfaces));
   t.coverage = detail::depth_coverage(images.depth);
   t.subpixel = detail::check_truth_holds_samples(where, t.visible, scene, view);
-  t.depth_error_only = seen_only_through_depth_errors(scene, view, images.ids, images.depth, renderer_->width(),
-                                                      renderer_->height());
+  t.depth_error_only = seen_only_through_depth_errors(scene, view, images.ids, images.depth, device_->width(),
+                                                      device_->height());
   if (box_reach_) {
-    t.box_reach = boxes_reaching_depth(scene, view, in_frustum, images.depth, renderer_->width(), renderer_->height());
+    t.box_reach = boxes_reaching_depth(scene, view, in_frustum, images.depth, device_->width(), device_->height());
     if (hooks_ && hooks_->box_reach) hooks_->box_reach(t.box_reach);
     detail::check_box_reach_holds_truth(where, t.visible, t.depth_error_only, t.box_reach);
   }
@@ -265,7 +265,7 @@ FrameTruth Session::truth_of(const View& view, const detail::FrameLabel& where) 
 std::vector<ObjectId> Session::verify_frame(std::string_view name, const Culler& culler, const CameraPath& path,
                                             int k, const FrameTruth& t, FrameStats& s) {
   const detail::FrameLabel where{scene_spec_, path.name(), k};
-  std::vector<float> depth = renderer_->read_depth();
+  std::vector<float> depth = device_->read_depth();
   if (hooks_ && hooks_->frame_depth) hooks_->frame_depth(depth);
   const Coverage frame = detail::depth_coverage(depth);
   detail::check_frame_within_truth(where, std::string(name), t.coverage, frame);

@@ -50,8 +50,7 @@ void Renderer::Impl::split_translucent(std::span<const ObjectId> objects, std::v
     (scene.material(scene.object(id).material).translucent ? translucent_out : opaque).push_back(id);
 }
 
-void Renderer::Impl::prepare_pass(const View& v) {
-  if (current.cmd) throw UsageError("vk::Renderer: a frame or pass began before the last one ended (end_frame)");
+void Renderer::Impl::prepare_pass(const View& v, bool clear) {
   if (scene.meshes().size() > meshes.size())
     throw UsageError(fmt::format("vk::Renderer: the scene has {} meshes, {} more than when the renderer was made; "
                                  "meshes added later need a new renderer",
@@ -60,6 +59,7 @@ void Renderer::Impl::prepare_pass(const View& v) {
     throw UsageError(fmt::format("vk::Renderer: the scene has {} objects, {} more than when the renderer was made; "
                                  "objects added later need a new renderer (ids removed and reused are fine)",
                                  scene.objects().size(), scene.objects().size() - object_capacity));
+  if (current.cmd) submit();  // a frame left without end_frame (an exception): its commands run and are dropped
   wait_all();  // the uniforms and box chunks are rewritten below and by this pass
   view = v;
   clip = v.clip;
@@ -78,13 +78,14 @@ void Renderer::Impl::prepare_pass(const View& v) {
   conditions_used = 0;
   box_chunk = 0;
   box_offset = 0;
+  in_frame = true;
   begin_batch();
   if (timestamps) {
     vkResetQueryPool(vk.device, timestamps, 0, 2);
     vkCmdWriteTimestamp(current.cmd, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, timestamps, 0);
     timed = true;
   }
-  begin_pass(true);
+  begin_pass(clear);
 }
 
 void Renderer::Impl::bind(VkPipeline p) {
@@ -146,7 +147,7 @@ void Renderer::begin_frame(const View& view) {
 
 double Renderer::end_frame() {
   Impl& g = *impl_;
-  if (!g.current.cmd) throw UsageError("vk::Renderer::end_frame: no frame began (begin_frame)");
+  if (!g.in_frame) throw UsageError("vk::Renderer::end_frame: no frame began (begin_frame)");
   if (!g.translucent.empty()) {
     std::sort(g.translucent.begin(), g.translucent.end(), [&](ObjectId a, ObjectId b) {
       const glm::vec3 da = g.scene.object(a).bounds.center() - g.eye;
@@ -161,6 +162,7 @@ double Renderer::end_frame() {
   if (g.timed) vkCmdWriteTimestamp(g.current.cmd, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, g.timestamps, 1);
   g.submit();
   g.wait_all();
+  g.in_frame = false;
   for (const Impl::ConditionalDraw& d : g.conditional) {
     std::uint64_t samples = 0;
     check(vkGetQueryPoolResults(g.vk.device, g.pool_of(d.query), Impl::index_of(d.query), 1, sizeof samples, &samples,
@@ -355,7 +357,8 @@ std::uint64_t Renderer::unread_result(QueryId q) {
 void Renderer::set_write_ids(bool on) { impl_->write_ids = on; }
 std::size_t Renderer::queries_in_flight() const noexcept { return impl_->in_flight; }
 
-std::vector<Renderer::ObjectPixels> Renderer::visible_pixels(const View& view, std::span<const ObjectId> objects) {
+std::vector<Renderer::ObjectPixels> Renderer::visible_pixels(const View& view, std::span<const ObjectId> objects,
+                                                             PassImages* images) {
   Impl& g = *impl_;
   const BackendStats saved_stats = stats_;
   const bool saved_ids = g.write_ids;
@@ -393,8 +396,13 @@ std::vector<Renderer::ObjectPixels> Renderer::visible_pixels(const View& view, s
                                 VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT),
           "vkGetQueryPoolResults (truth)");
   std::vector<std::uint32_t> counts(g.scene.objects().size(), 0);
-  for (std::uint32_t v : read_ids())
+  std::vector<std::uint32_t> id_image = read_ids();
+  for (std::uint32_t v : id_image)
     if (v != 0 && v <= counts.size()) ++counts[v - 1];
+  if (images) {
+    images->ids = std::move(id_image);
+    images->depth = read_depth();
+  }
   for (std::size_t i = 0; i < translucent.size(); ++i)
     counts[translucent[i]] = std::uint32_t(std::min<std::uint64_t>(samples[i], 0xffffffffu));
   std::vector<ObjectPixels> visible;
@@ -405,10 +413,52 @@ std::vector<Renderer::ObjectPixels> Renderer::visible_pixels(const View& view, s
   return visible;
 }
 
+std::uint64_t Renderer::samples_in_front(const View& view, std::span<const ObjectId> objects) {
+  Impl& g = *impl_;
+  const BackendStats saved_stats = stats_;
+  g.prepare_pass(view, false);
+  if (!g.truth_pool) {
+    g.truth_capacity = 64;
+    g.truth_pool = g.make_query_pool(VK_QUERY_TYPE_OCCLUSION, g.truth_capacity);
+  } else {
+    vkResetQueryPool(g.vk.device, g.truth_pool, 0, 1);
+  }
+  VkCommandBuffer cmd = g.recording();
+  vkCmdBeginQuery(cmd, g.truth_pool, 0, VK_QUERY_CONTROL_PRECISE_BIT);
+  g.draw_objects(objects, stats_, detail::PipelineKind::depth_test);
+  vkCmdEndQuery(cmd, g.truth_pool, 0);
+  g.timed = false;  // an untimed pass: its start stamp is never read
+  g.submit();
+  g.wait_all();
+  g.in_frame = false;
+  std::uint64_t samples = 0;
+  check(vkGetQueryPoolResults(g.vk.device, g.truth_pool, 0, 1, sizeof samples, &samples, sizeof samples,
+                              VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT),
+        "vkGetQueryPoolResults (samples in front)");
+  stats_ = saved_stats;
+  g.context.check("counting samples in front of the depth image");
+  return samples;
+}
+
+Renderer::Resources Renderer::resources() const {
+  const Impl& g = *impl_;
+  Resources r;
+  r.queries = g.query_pools.size() * detail::kQueriesPerPool;
+  r.queries_free = r.queries - g.in_flight;
+  const auto add = [&](const detail::Buffer& b) {
+    if (!b.buffer) return;
+    ++r.buffers;
+    r.buffer_bytes += std::int64_t(b.size);
+  };
+  for (const detail::Buffer* b : {&g.vertices, &g.indices, &g.cube, &g.uniforms, &g.readback, &g.conditions}) add(*b);
+  for (const detail::Buffer& b : g.box_chunks) add(b);
+  return r;
+}
+
 std::vector<std::uint8_t> Renderer::Impl::read_image(const detail::Image& image, VkImageAspectFlags aspect,
                                                      VkImageLayout layout, VkPipelineStageFlags stage,
                                                      VkAccessFlags access) {
-  if (current.cmd) throw UsageError("vk::Renderer: images are read after end_frame(), not during a frame");
+  if (in_frame) throw UsageError("vk::Renderer: images are read after end_frame(), not during a frame");
   run_once([&](VkCommandBuffer cmd) {
     VkImageMemoryBarrier b{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER};
     b.srcAccessMask = access;

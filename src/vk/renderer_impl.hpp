@@ -121,6 +121,7 @@ struct Renderer::Impl {
   std::vector<detail::Batch> pending_batches;  // submitted, not yet known done
   detail::Batch current{};                     // recording; cmd null when none
   bool in_pass = false;                        // current is inside a render pass
+  bool in_frame = false;                       // between prepare_pass and the pass's end (end_frame)
   std::uint64_t batch_serial = 1;              // serial of `current` (the next one to submit)
 
   // Queries: QueryId q is query q % kQueriesPerPool of pool q / kQueriesPerPool.
@@ -187,7 +188,9 @@ struct Renderer::Impl {
   void run_once(Record&& record);
 
   // renderer.cpp
-  void prepare_pass(const View& v);
+  // Waits for the last pass, sets the uniforms and begins recording a pass
+  // that clears the images, or keeps them (`clear` false).
+  void prepare_pass(const View& v, bool clear = true);
   void enter_render_state(BackendStats& stats);
   void enter_query_state(BackendStats& stats);
   void bind(VkPipeline p);

@@ -99,10 +99,21 @@ class Renderer final : public Backend {
     std::uint32_t pixels;  ///< opaque: id-image pixels; translucent: samples passing the depth test
     friend bool operator==(const ObjectPixels&, const ObjectPixels&) = default;
   };
+  /// The images a measuring pass read back (bottom row first).
+  struct PassImages {
+    std::vector<std::uint32_t> ids;  ///< 0 background, else object id + 1
+    std::vector<float> depth;        ///< canonical window depth (read_depth())
+  };
   /// Untimed measuring pass (ground truth), as gl::Renderer::visible_pixels:
-  /// every object of `objects` with a visible pixel for `view`, sorted by id.
-  /// Overwrites the images; not counted in stats(). Outside begin/end_frame.
-  [[nodiscard]] std::vector<ObjectPixels> visible_pixels(const View& view, std::span<const ObjectId> objects);
+  /// every object of `objects` with a visible pixel for `view`, sorted by id;
+  /// with `images`, also the id and depth images it drew. Overwrites the
+  /// images; not counted in stats(). Outside begin/end_frame.
+  [[nodiscard]] std::vector<ObjectPixels> visible_pixels(const View& view, std::span<const ObjectId> objects,
+                                                         PassImages* images = nullptr);
+  /// Untimed, as gl::Renderer::samples_in_front: draws `objects` against the
+  /// depth image as the last pass left it, writing nothing, and returns the
+  /// samples passing its depth test. Outside begin/end_frame.
+  [[nodiscard]] std::uint64_t samples_in_front(const View& view, std::span<const ObjectId> objects);
 
   /// The object-id image after end_frame(): width*height values, bottom row
   /// first; 0 background, else object id + 1.
@@ -112,6 +123,15 @@ class Renderer final : public Backend {
   [[nodiscard]] std::vector<float> read_depth();
   /// The colour image after end_frame(): RGBA8, top row first.
   [[nodiscard]] std::vector<std::uint8_t> read_rgba();
+
+  /// What the renderer holds (occull soak watches it grow).
+  struct Resources {
+    std::size_t queries = 0;       ///< occlusion queries in its pools (in use and free)
+    std::size_t queries_free = 0;  ///< ... of them free for the next issue_query()
+    std::size_t buffers = 0;       ///< buffers it made
+    std::int64_t buffer_bytes = 0; ///< their sizes, bytes
+  };
+  [[nodiscard]] Resources resources() const;
 
   void set_write_ids(bool on);
   [[nodiscard]] std::size_t queries_in_flight() const noexcept;
