@@ -10,7 +10,10 @@
 #include "occull/scenes.hpp"
 #include "occull/vk/context.hpp"
 #include "occull/vk/renderer.hpp"
+#include "occull/lab.hpp"
 
+#include "conservative_walk.hpp"
+#include "require_data.hpp"
 #include "vk/vk.hpp"
 
 #include <gtest/gtest.h>
@@ -125,6 +128,104 @@ TEST_F(VulkanTest, VisibleSetsEqualOpenGlsUpToPixelEdges) {
                 pixels_differ, pixels);
     EXPECT_LE(double(pixels_differ), 0.01 * double(pixels));
   }
+}
+
+// The conservative cullers that need no device culling (hiz is the GL
+// renderer's: DeviceCulling is not in vk::Renderer yet), through Vulkan.
+const char* const kConservative[] = {"stopwait", "chc", "chcpp", "chcpp:multiquery=off", "nohc", "soc",
+                                     "auto:candidates=soc+nohc+chcpp:trial=1:period=2"};
+
+Options fixed_profile() {
+  Options o;
+  o.set("nohc.profile", OCCULL_TEST_PROFILE);
+  return o;
+}
+
+gl::ContextOptions validated() {
+  gl::ContextOptions c;
+  c.debug = true;  // Vulkan: the validation layer
+  return c;
+}
+
+gl::RendererOptions small_target(int width = 192, int height = 108) {
+  gl::RendererOptions o;
+  o.width = width;
+  o.height = height;
+  o.write_ids = false;
+  return o;
+}
+
+// Every conservative culler over every path of `spec` through Vulkan misses
+// nothing, and where the walks hide much, culls; the validation layer reports nothing.
+void expect_conservative_through_vulkan(const std::string& spec, const gl::RendererOptions& target,
+                                        std::vector<std::string_view> unbounded = {"nohc", "auto"}) {
+  Session session(spec, target, {}, validated(), Api::vulkan);
+  ASSERT_EQ(session.api(), Api::vulkan);
+  test::CullingTally tally;
+  for (const CameraPath& path : session.bundle().paths)
+    test::run_walk(session, path, 8, kConservative, fixed_profile(), tally, spec + "/" + path.name());
+  tally.expect_culling(unbounded);
+  EXPECT_NO_THROW(session.render_device().check("the walks"));
+}
+
+TEST(VulkanCulling, ConservativeCullersMissNothingOnTheCity) {
+  expect_conservative_through_vulkan("city:blocks=4,traffic=40", small_target());
+}
+
+TEST(VulkanCulling, ConservativeCullersMissNothingOnTheField) {
+  expect_conservative_through_vulkan("field:objects=800,size=300", small_target());
+}
+
+TEST(VulkanCulling, ConservativeCullersMissNothingOnEveryAdversarialKind) {
+  for (const char* kind : {"mixed", "tiny", "thin", "coplanar", "near", "far", "farout"})
+    expect_conservative_through_vulkan(std::string("adversarial:kind=") + kind, small_target(320, 180),
+                                       {"nohc", "auto", "chcpp"});  // as the GL suite (adversarial_test.cpp)
+}
+
+TEST(VulkanCulling, ConservativeCullersMissNothingOnOpenArenaMaps) {
+  const std::string pk3 = std::string(OCCULL_DATA_DIR) + "/openarena/pak1-maps.pk3";
+  OCCULL_REQUIRE_DATA(pk3);
+  for (const char* map : {"oasago2", "wrackdm17"})
+    expect_conservative_through_vulkan(std::string("q3:") + pk3 + ":" + map, small_target());
+}
+
+// What the verifier would say of a culler that misses: the check can fail.
+// Drawing nothing through Vulkan (none draws every object: `oracle` with an
+// empty truth is not available, so a culler that culls everything is made
+// by the session's fault hooks) is caught as misses.
+TEST(VulkanCulling, ACullerThatDrawsTooLittleIsCaught) {
+  Session session("city:blocks=4", small_target(), {}, validated(), Api::vulkan);
+  const CameraPath& path = session.bundle().paths.front();
+  const auto truth = session.ground_truth(path, 4);
+  ASSERT_FALSE(truth.front().visible.empty());
+  auto vfc = session.make("vfc", Options{});
+  const AlgorithmRun full = session.run_path("vfc", *vfc, path, 4, &truth);
+  session.release(*vfc);
+  std::uint64_t missed = 0;
+  for (const FrameStats& f : full.frames) missed += f.missed_objects;
+  EXPECT_EQ(missed, 0u);
+  // chc with a threshold no query passes: it draws nothing it queried.
+  auto blind = session.make("chc:threshold=1000000", Options{});
+  const AlgorithmRun run = session.run_path("chc", *blind, path, 4, &truth);
+  session.release(*blind);
+  missed = 0;
+  for (const FrameStats& f : run.frames) missed += f.missed_objects;
+  EXPECT_GT(missed, 0u);
+}
+
+// Reading a result in the frame that issued it costs a submission in
+// Vulkan: CHC's in-frame reads are counted as flushes, and wait time.
+TEST(VulkanCulling, MidFrameReadsAreCountedAsSubmissions) {
+  Session session("city:blocks=4", small_target(), {}, validated(), Api::vulkan);
+  const CameraPath& path = session.bundle().paths.front();
+  auto chc = session.make("chc", Options{});
+  const AlgorithmRun run = session.run_path("chc", *chc, path, 6, nullptr);
+  session.release(*chc);
+  double flushes = 0, queries = 0;
+  for (const FrameStats& f : run.frames) flushes += f.flushes, queries += f.queries;
+  EXPECT_GT(queries, 0.0);
+  EXPECT_GT(flushes, 0.0);
+  EXPECT_LE(flushes, queries);  // at most one submission per query read
 }
 
 }  // namespace
