@@ -228,5 +228,41 @@ TEST(VulkanCulling, MidFrameReadsAreCountedAsSubmissions) {
   EXPECT_LE(flushes, queries);  // at most one submission per query read
 }
 
+// chc:reads=earlier reads results of earlier frames only, as engines on
+// explicit APIs do: no submission mid-frame, nothing waited for, and it is
+// not conservative (what it draws late is counted as popping, not failure).
+TEST(VulkanCulling, ChcReadingEarlierFramesSubmitsNothingMidFrame) {
+  EXPECT_FALSE(is_conservative(parse_algorithm_spec("chc:reads=earlier")));
+  EXPECT_TRUE(is_conservative(parse_algorithm_spec("chc:reads=frame")));
+  Session session("city:blocks=4", small_target(), {}, validated(), Api::vulkan);
+  EXPECT_EQ(session.backend().result_reads(), ResultReads::after_submit);
+  EXPECT_THROW((void)session.make("chc:reads=earlier:cpu_test=on", Options{}), InputError);
+  const CameraPath& path = session.bundle().paths.front();
+  session.set_sampling({30.0, 0.0});
+  const auto truth = session.ground_truth(path, 12);
+  auto latent = session.make("chc:reads=earlier", Options{});
+  const AlgorithmRun run = session.run_path("chc:reads=earlier", *latent, path, 12, &truth);
+  EXPECT_GT(latent->queries_held(), 0u);  // the last frame's, for the next
+  session.release(*latent);
+  EXPECT_EQ(latent->queries_held(), 0u);
+  session.check_queries_returned("chc:reads=earlier");
+  std::uint64_t flushes = 0, queries = 0, waits = 0, drawn = 0, visible = 0, missed = 0;
+  for (std::size_t k = 0; k < run.frames.size(); ++k) {
+    const FrameStats& f = run.frames[k];
+    flushes += f.flushes, queries += f.queries, waits += f.blocking_waits, drawn += f.objects_rendered;
+    visible += truth[k].visible.size();
+    if (k >= 2) missed += f.missed_objects;  // past its start (frame 0 knows nothing yet)
+  }
+  EXPECT_GT(queries, 0u);
+  EXPECT_EQ(flushes, 0u);
+  EXPECT_EQ(waits, 0u);
+  EXPECT_LE(double(missed), 0.1 * double(visible));  // a frame late on the few that turn visible
+  std::uint64_t vfc_drawn = 0;
+  auto vfc = session.make("vfc", Options{});
+  for (const FrameStats& f : session.run_path("vfc", *vfc, path, 12, nullptr).frames) vfc_drawn += f.objects_rendered;
+  session.release(*vfc);
+  EXPECT_LT(drawn, vfc_drawn);  // and it culls
+}
+
 }  // namespace
 }  // namespace occull

@@ -68,6 +68,23 @@ enum class ConditionalWait : std::uint8_t {
   no_wait,  ///< draws anyway (GL_QUERY_NO_WAIT): never stalls, skips only known-hidden draws
 };
 
+/// What reading a query's result costs in the frame that issued it: how a
+/// backend says what its reads cost (Backend::result_reads). docs/library.md,
+/// "Vulkan and other explicit APIs".
+enum class ResultReads : std::uint8_t {
+  /// Results can be polled and read mid-frame; polling or reading a query
+  /// the device has not been handed makes the driver flush (OpenGL).
+  in_frame,
+  /// A result exists only once the commands that issued its query were
+  /// submitted and ran. Polling or reading a query recorded since the last
+  /// submission submits everything recorded so far (the render pass ends,
+  /// the next commands begin another) and a read then waits for the device
+  /// (Vulkan, Direct3D 12, Metal). Each counts in BackendStats::flushes, the
+  /// waiting in wait_ms. Engines on these APIs read results of earlier frames
+  /// only: chc:reads=earlier.
+  after_submit,
+};
+
 class Backend {
  public:
   virtual ~Backend() = default;
@@ -110,6 +127,11 @@ class Backend {
     (void)wait;
     render(objects);
   }
+
+  /// What reading a result in the frame that issued its query costs here
+  /// (the default: in_frame, as OpenGL). A decorator forwards its inner
+  /// backend's.
+  [[nodiscard]] virtual ResultReads result_reads() const { return ResultReads::in_frame; }
 
   /// Asks the device to start work submitted so far without waiting for it
   /// (glFlush); helps queries finish while the culler does other work.

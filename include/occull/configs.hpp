@@ -74,6 +74,12 @@ struct ChcConfig {
   QueryOptions common;
   std::uint32_t skip = 0;         ///< n_av: a visible leaf is queried every n_av + 1 frames; in [0, 1000]
   std::uint32_t flush_every = 8;  ///< queries handed to the device together; in [1, 2^20]
+  /// Option reads=earlier: read every result at the start of the next frame,
+  /// never in the frame that issued it, as engines on explicit APIs do with
+  /// frames in flight (Backend::result_reads, after_submit): no submission
+  /// or wait mid-frame, but a node that turns visible is drawn a frame late.
+  /// Not conservative. reads=frame (false, the default): CHC as published.
+  bool reads_earlier = false;
 };
 
 /// CHC++ (Mattausch, Bittner & Wimmer 2008): batched queues, render queue,

@@ -67,6 +67,7 @@ class CpuTestBackend final : public Backend {
   void render_conditional(std::span<const ObjectId> objects, QueryId q, ConditionalWait wait) override;
   void flush() override;
   [[nodiscard]] DeviceCulling* device_culling() override;
+  [[nodiscard]] ResultReads result_reads() const override;
   [[nodiscard]] BackendStats stats() const override;
 
  private:

@@ -57,6 +57,7 @@ class LoggingBackend final : public Backend {
   void render_conditional(std::span<const ObjectId> objects, QueryId q, ConditionalWait wait) override;
   void flush() override { inner_.flush(); }
   [[nodiscard]] DeviceCulling* device_culling() override { return inner_.device_culling(); }
+  [[nodiscard]] ResultReads result_reads() const override { return inner_.result_reads(); }
   [[nodiscard]] BackendStats stats() const override { return inner_.stats(); }
 
  private:

@@ -60,6 +60,7 @@ class RecordingBackend final : public Backend, private DeviceCulling {
   void render_conditional(std::span<const ObjectId> objects, QueryId q, ConditionalWait wait) override;
   void flush() override { inner_.flush(); }
   [[nodiscard]] BackendStats stats() const override;
+  [[nodiscard]] ResultReads result_reads() const override { return inner_.result_reads(); }
   [[nodiscard]] DeviceCulling* device_culling() override {
     return inner_.device_culling() ? static_cast<DeviceCulling*>(this) : nullptr;
   }

@@ -52,6 +52,7 @@ class StallGuard final : public Backend {
   }
   void flush() override { inner_.flush(); }
   [[nodiscard]] DeviceCulling* device_culling() override { return inner_.device_culling(); }
+  [[nodiscard]] ResultReads result_reads() const override { return inner_.result_reads(); }
   [[nodiscard]] BackendStats stats() const override;
 
  private:

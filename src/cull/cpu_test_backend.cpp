@@ -146,6 +146,9 @@ void CpuTestBackend::render_conditional(std::span<const ObjectId> objects, Query
 
 void CpuTestBackend::flush() { impl_->inner_backend().flush(); }
 DeviceCulling* CpuTestBackend::device_culling() { return impl_->inner_backend().device_culling(); }
+ResultReads CpuTestBackend::result_reads() const {
+  return impl_->inner ? impl_->inner->result_reads() : ResultReads::in_frame;
+}
 BackendStats CpuTestBackend::stats() const {
   return impl_->inner ? impl_->inner->stats() : BackendStats{};
 }

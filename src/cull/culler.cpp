@@ -224,6 +224,7 @@ class DrawRecorder final : public Backend {
   }
   void flush() override { inner->flush(); }
   [[nodiscard]] DeviceCulling* device_culling() override { return inner->device_culling(); }
+  [[nodiscard]] ResultReads result_reads() const override { return inner->result_reads(); }
   [[nodiscard]] BackendStats stats() const override { return inner->stats(); }
 
  private:

@@ -163,6 +163,20 @@ double Renderer::end_frame() {
   g.submit();
   g.wait_all();
   g.in_frame = false;
+  if (g.in_flight > 0) {  // the device is done with all of them: one read per pool
+    std::vector<std::uint64_t> pairs(2 * detail::kQueriesPerPool);
+    for (std::size_t pool = 0; pool < g.query_pools.size(); ++pool) {
+      const VkResult r = vkGetQueryPoolResults(g.vk.device, g.query_pools[pool], 0, detail::kQueriesPerPool,
+                                               pairs.size() * sizeof(std::uint64_t), pairs.data(),
+                                               2 * sizeof(std::uint64_t),
+                                               VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WITH_AVAILABILITY_BIT);
+      if (r != VK_NOT_READY) check(r, "vkGetQueryPoolResults (the frame's queries)");
+      for (std::uint32_t i = 0; i < detail::kQueriesPerPool; ++i) {
+        const QueryId q = QueryId(pool * detail::kQueriesPerPool + i);
+        if (q < g.query_live.size() && g.query_live[q] && pairs[2 * i + 1] != 0) g.query_known[q] = pairs[2 * i] + 1;
+      }
+    }
+  }
   for (const Impl::ConditionalDraw& d : g.conditional) {
     std::uint64_t samples = 0;
     check(vkGetQueryPoolResults(g.vk.device, g.pool_of(d.query), Impl::index_of(d.query), 1, sizeof samples, &samples,
@@ -250,6 +264,7 @@ QueryId Renderer::issue_query(std::span<const Aabb> boxes) {
       g.query_pools.push_back(g.make_query_pool(VK_QUERY_TYPE_OCCLUSION, detail::kQueriesPerPool));
     g.query_live.push_back(0);
     g.query_batch.push_back(0);
+    g.query_known.push_back(0);
   } else {
     q = g.free_queries.back();
     g.free_queries.pop_back();
@@ -257,6 +272,7 @@ QueryId Renderer::issue_query(std::span<const Aabb> boxes) {
   }
   ++g.in_flight;
   g.query_live[q] = 1;
+  g.query_known[q] = 0;
   g.query_batch[q] = g.batch_serial;
   // A box around the eye shows only back faces: both sides for it.
   bool around_eye = false;
@@ -293,6 +309,7 @@ bool Renderer::result_available(QueryId q) {
   Impl& g = *impl_;
   g.check_in_flight(q, "result_available");
   ScopedTimer timer(stats_.backend_ms);
+  if (g.query_known[q]) return true;
   if (g.query_batch[q] == g.batch_serial && g.current.cmd) {  // recorded, not submitted: hand it to the device
     g.submit();
     ++stats_.flushes;
@@ -308,19 +325,23 @@ std::uint64_t Renderer::result(QueryId q) {
   Impl& g = *impl_;
   g.check_in_flight(q, "result");
   const auto t0 = Clock::now();
-  if (g.query_batch[q] == g.batch_serial && g.current.cmd) {
-    g.submit();
-    ++stats_.flushes;
-  }
   std::uint64_t samples = 0;
-  VkResult r = vkGetQueryPoolResults(g.vk.device, g.pool_of(q), Impl::index_of(q), 1, sizeof samples, &samples,
-                                     sizeof samples, VK_QUERY_RESULT_64_BIT);
-  if (r == VK_NOT_READY) {
-    ++stats_.blocking_waits;
-    r = vkGetQueryPoolResults(g.vk.device, g.pool_of(q), Impl::index_of(q), 1, sizeof samples, &samples,
-                              sizeof samples, VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT);
+  if (g.query_known[q]) {
+    samples = g.query_known[q] - 1;
+  } else {
+    if (g.query_batch[q] == g.batch_serial && g.current.cmd) {
+      g.submit();
+      ++stats_.flushes;
+    }
+    VkResult r = vkGetQueryPoolResults(g.vk.device, g.pool_of(q), Impl::index_of(q), 1, sizeof samples, &samples,
+                                       sizeof samples, VK_QUERY_RESULT_64_BIT);
+    if (r == VK_NOT_READY) {
+      ++stats_.blocking_waits;
+      r = vkGetQueryPoolResults(g.vk.device, g.pool_of(q), Impl::index_of(q), 1, sizeof samples, &samples,
+                                sizeof samples, VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT);
+    }
+    check(r, "vkGetQueryPoolResults");
   }
-  check(r, "vkGetQueryPoolResults");
   const double ms = ms_since(t0);
   stats_.wait_ms += ms;
   stats_.backend_ms += ms;
@@ -346,6 +367,7 @@ void Renderer::flush() {
 std::uint64_t Renderer::unread_result(QueryId q) {
   Impl& g = *impl_;
   g.check_in_flight(q, "unread_result");
+  if (g.query_known[q]) return g.query_known[q] - 1;
   if (g.query_batch[q] == g.batch_serial && g.current.cmd) g.submit();
   std::uint64_t samples = 0;
   check(vkGetQueryPoolResults(g.vk.device, g.pool_of(q), Impl::index_of(q), 1, sizeof samples, &samples, sizeof samples,

@@ -128,6 +128,10 @@ struct Renderer::Impl {
   std::vector<VkQueryPool> query_pools;
   std::vector<std::uint64_t> query_batch;  // QueryId -> batch_serial it was recorded in
   std::vector<std::uint8_t> query_live;    // QueryId -> issued and not yet read
+  // QueryId -> its result + 1 once known, 0 until then: end_frame reads the
+  // results of every query in flight in one call per pool (results of
+  // earlier frames, as engines read them, then cost no call of their own).
+  std::vector<std::uint64_t> query_known;
   std::vector<QueryId> free_queries;
   std::size_t in_flight = 0;
   VkQueryPool truth_pool = VK_NULL_HANDLE;  // the truth pass's translucent tests

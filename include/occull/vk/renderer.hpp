@@ -88,6 +88,8 @@ class Renderer final : public Backend {
   /// on the device, which orders the copy after the query.
   void render_conditional(std::span<const ObjectId> objects, QueryId q, ConditionalWait wait) override;
   [[nodiscard]] BackendStats stats() const override { return stats_; }
+  /// after_submit: a mid-frame read of a query not yet submitted submits (see above).
+  [[nodiscard]] ResultReads result_reads() const override { return ResultReads::after_submit; }
 
   /// The result of query `q` without ending its flight (an instrument after
   /// end_frame(): what a conditional draw drew). Waits; not counted.
