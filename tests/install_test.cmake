@@ -69,4 +69,9 @@ else()
   endif()
   build_and_run("the consumer" tests/consumer consumer)
   build_and_run("the example engine" examples/engine occull_example_engine --frames 20 --size 96x54)
+  # The Vulkan example, where the vk component was built and installed (not under the
+  # sanitizers: see tests/CMakeLists.txt, the Vulkan example engine).
+  if(EXISTS "${prefix}/lib/cmake/occull/occull-vk-targets.cmake" AND NOT SANITIZE)
+    build_and_run("the Vulkan example engine" examples/vk_engine occull_example_vk_engine --frames 20 --size 96x54)
+  endif()
 endif()

@@ -1,7 +1,12 @@
-// `occull info`: the GL device: vendor, renderer, version, query counter bits, culling extensions.
+// `occull info`: the GL device: vendor, renderer, version, query counter bits, culling extensions;
+// and the Vulkan device `--api vulkan` would render on, where this build has Vulkan.
 #include "cli.hpp"
+#include "occull/error.hpp"
 #include "occull/gl/context.hpp"
 #include "occull/gl/renderer.hpp"
+#ifdef OCCULL_HAVE_VULKAN
+#include "occull/vk/context.hpp"
+#endif
 
 #include <fmt/format.h>
 
@@ -24,13 +29,27 @@ int cmd_info() {
              occull::gl::describe_query_raster(occull::gl::RendererOptions{}));
   fmt::print("culling-relevant extensions ({}):\n", d.culling_extensions.size());
   for (const auto& e : d.culling_extensions) fmt::print("  {}\n", e);
+#ifdef OCCULL_HAVE_VULKAN
+  try {
+    const auto vk = occull::vk::Context::create();
+    const occull::vk::DeviceInfo& v = vk->info();
+    fmt::print("Vulkan (--api vulkan): {} | Vulkan {} | {}\n  conditional rendering {}, drawIndirectCount {}, "
+               "timestamps {} bits\n",
+               v.name, v.api_version, v.driver, v.conditional_rendering ? "yes" : "no",
+               v.draw_indirect_count ? "yes" : "no", v.timestamp_bits);
+  } catch (const occull::VulkanUnavailable& e) {
+    fmt::print("Vulkan (--api vulkan): unavailable: {}\n", e.what());
+  }
+#else
+  fmt::print("Vulkan (--api vulkan): not in this build (needs libvulkan-dev and glslc at build time)\n");
+#endif
   return 0;
 }
 
 }  // namespace
 
 Command add_info(CLI::App& app) {
-  app.add_subcommand("info", "GL vendor, renderer, version, query counter bits, culling extensions");
+  app.add_subcommand("info", "GL vendor, renderer, version, query counter bits, culling extensions; the Vulkan device");
   return cmd_info;
 }
 

@@ -23,9 +23,9 @@ using namespace occull::app;
 // The exit codes, as --help prints them and the README's table lists them.
 constexpr std::pair<int, const char*> kExitCodes[] = {
     {0, "success"},
-    {1, "internal error (a bug: please report it with the message), including a violated run-time invariant of the instrument, with `--gl-debug` a failing OpenGL call, and a frame past the `--watchdog` time"},
+    {1, "internal error (a bug: please report it with the message), including a violated run-time invariant of the instrument, with `--gl-debug` a failing OpenGL call or a Vulkan validation error, and a frame past the `--watchdog` time"},
     {2, "bad input: unknown scene / path / algorithm / option (the message lists the valid ones), invalid number or size, a damaged level, model, path or profile file (the message names the file and the fault), an output file or folder that cannot be written"},
-    {3, "no usable OpenGL 4.5: EGL or the driver is missing (the message says which package); `view`: no display, or built without its viewer"},
+    {3, "no usable OpenGL 4.5 (EGL or the driver is missing), or with `--api vulkan` no usable Vulkan 1.2 device (the message says which package); `view`: no display, or built without its viewer"},
     {4, "`bench`, `osg`: verification failed — a conservative algorithm culled a visible object (the table, JSON and report are written first)"},
     {5, "`soak`: a leak — a figure more than 5 % above its first window and still growing (the table and JSON are written first)"},
 };
@@ -100,6 +100,12 @@ int main(int argc, char** argv) {
   } catch (const occull::GlUnavailable& e) {
     std::cerr << "occull: no usable OpenGL: " << e.what() << "\n";
     return kExitNoGl;
+  } catch (const occull::VulkanUnavailable& e) {
+    std::cerr << "occull: no usable Vulkan: " << e.what() << "\n";
+    return kExitNoGl;
+  } catch (const occull::VulkanError& e) {
+    std::cerr << "occull: " << e.what() << "\n";
+    return kExitInternal;
   } catch (const occull::InvariantViolation& e) {
     std::cerr << "occull: " << e.what() << "\n";
     return kExitInternal;
