@@ -248,6 +248,14 @@ TEST(VulkanCulling, MidFrameReadsAreCountedAsSubmissions) {
   EXPECT_LE(flushes, queries);  // at most one submission per query read
 }
 
+// hiz culls on the device, which vk::Renderer does not offer yet: refused
+// up front as bad input (exit 2), not in the middle of a run.
+TEST(VulkanCulling, DeviceCullersAreRefusedUpFront) {
+  Session session("city:blocks=3", small_target(), {}, validated(), Api::vulkan);
+  EXPECT_THROW((void)session.make("hiz", Options{}), InputError);
+  EXPECT_NO_THROW((void)session.make("chcpp", Options{}));
+}
+
 // chc:reads=earlier reads results of earlier frames only, as engines on
 // explicit APIs do: no submission mid-frame, nothing waited for, and it is
 // not conservative (what it draws late is counted as popping, not failure).

@@ -277,6 +277,10 @@ std::unique_ptr<Culler> Session::make(std::string_view spec, const Options& opti
       throw InputError(fmt::format("option oracle.set: '{}' is not one of pixels, boxes", value));
     return std::make_unique<detail::OracleCuller>(bundle_.scene, value == "boxes");
   }
+  if (find_algorithm(a.name).device && !device_->backend().device_culling())
+    throw InputError(fmt::format("{} culls on the device, and the {} renderer has no device culling "
+                                 "(DeviceCulling is occull's OpenGL renderer's only): run it with --api gl",
+                                 a.name, api_name(api())));
   return make_culler(a.name, index(), a.options, culler_context(progress));
 }
 
