@@ -13,6 +13,7 @@
 #include "occull/lab.hpp"
 
 #include "conservative_walk.hpp"
+#include "gl_test_util.hpp"
 #include "require_data.hpp"
 #include "vk/vk.hpp"
 
@@ -162,13 +163,6 @@ gl::ContextOptions validated() {
   return c;
 }
 
-gl::RendererOptions small_target(int width = 192, int height = 108) {
-  gl::RendererOptions o;
-  o.width = width;
-  o.height = height;
-  o.write_ids = false;
-  return o;
-}
 
 // Every conservative culler over every path of `spec` through Vulkan misses
 // nothing, and where the walks hide much, culls; the validation layer reports nothing.
@@ -184,11 +178,11 @@ void expect_conservative_through_vulkan(const std::string& spec, const gl::Rende
 }
 
 TEST(VulkanCulling, ConservativeCullersMissNothingOnTheCity) {
-  expect_conservative_through_vulkan("city:blocks=4,traffic=40", small_target());
+  expect_conservative_through_vulkan("city:blocks=4,traffic=40", test::small_target(192, 108));
 }
 
 TEST(VulkanCulling, ConservativeCullersMissNothingOnTheField) {
-  expect_conservative_through_vulkan("field:objects=800,size=300", small_target());
+  expect_conservative_through_vulkan("field:objects=800,size=300", test::small_target(192, 108));
 }
 
 TEST(VulkanCulling, ConservativeCullersMissNothingOnEveryAdversarialKind) {
@@ -198,7 +192,7 @@ TEST(VulkanCulling, ConservativeCullersMissNothingOnEveryAdversarialKind) {
   const char* const kinds[] = {"mixed", "tiny", "thin", "coplanar", "near", "far", "farout"};
 #endif
   for (const char* kind : kinds)
-    expect_conservative_through_vulkan(std::string("adversarial:kind=") + kind, small_target(320, 180),
+    expect_conservative_through_vulkan(std::string("adversarial:kind=") + kind, test::small_target(320, 180),
                                        {"nohc", "auto", "chcpp"});  // as the GL suite (adversarial_test.cpp)
 }
 
@@ -206,7 +200,7 @@ TEST(VulkanCulling, ConservativeCullersMissNothingOnOpenArenaMaps) {
   const std::string pk3 = std::string(OCCULL_DATA_DIR) + "/openarena/pak1-maps.pk3";
   OCCULL_REQUIRE_DATA(pk3);
   for (const char* map : {"oasago2", "wrackdm17"})
-    expect_conservative_through_vulkan(std::string("q3:") + pk3 + ":" + map, small_target());
+    expect_conservative_through_vulkan(std::string("q3:") + pk3 + ":" + map, test::small_target(192, 108));
 }
 
 // What the verifier would say of a culler that misses: the check can fail.
@@ -214,7 +208,7 @@ TEST(VulkanCulling, ConservativeCullersMissNothingOnOpenArenaMaps) {
 // empty truth is not available, so a culler that culls everything is made
 // by the session's fault hooks) is caught as misses.
 TEST(VulkanCulling, ACullerThatDrawsTooLittleIsCaught) {
-  Session session("city:blocks=4", small_target(), {}, validated(), Api::vulkan);
+  Session session("city:blocks=4", test::small_target(192, 108), {}, validated(), Api::vulkan);
   const CameraPath& path = session.bundle().paths.front();
   const auto truth = session.ground_truth(path, 4);
   ASSERT_FALSE(truth.front().visible.empty());
@@ -236,7 +230,7 @@ TEST(VulkanCulling, ACullerThatDrawsTooLittleIsCaught) {
 // Reading a result in the frame that issued it costs a submission in
 // Vulkan: CHC's in-frame reads are counted as flushes, and wait time.
 TEST(VulkanCulling, MidFrameReadsAreCountedAsSubmissions) {
-  Session session("city:blocks=4", small_target(), {}, validated(), Api::vulkan);
+  Session session("city:blocks=4", test::small_target(192, 108), {}, validated(), Api::vulkan);
   const CameraPath& path = session.bundle().paths.front();
   auto chc = session.make("chc", Options{});
   const AlgorithmRun run = session.run_path("chc", *chc, path, 6, nullptr);
@@ -251,7 +245,7 @@ TEST(VulkanCulling, MidFrameReadsAreCountedAsSubmissions) {
 // hiz culls on the device, which vk::Renderer does not offer yet: refused
 // up front as bad input (exit 2), not in the middle of a run.
 TEST(VulkanCulling, DeviceCullersAreRefusedUpFront) {
-  Session session("city:blocks=3", small_target(), {}, validated(), Api::vulkan);
+  Session session("city:blocks=3", test::small_target(192, 108), {}, validated(), Api::vulkan);
   EXPECT_THROW((void)session.make("hiz", Options{}), InputError);
   EXPECT_NO_THROW((void)session.make("chcpp", Options{}));
 }
@@ -262,7 +256,7 @@ TEST(VulkanCulling, DeviceCullersAreRefusedUpFront) {
 TEST(VulkanCulling, ChcReadingEarlierFramesSubmitsNothingMidFrame) {
   EXPECT_FALSE(is_conservative(parse_algorithm_spec("chc:reads=earlier")));
   EXPECT_TRUE(is_conservative(parse_algorithm_spec("chc:reads=frame")));
-  Session session("city:blocks=4", small_target(), {}, validated(), Api::vulkan);
+  Session session("city:blocks=4", test::small_target(192, 108), {}, validated(), Api::vulkan);
   EXPECT_EQ(session.backend().result_reads(), ResultReads::after_submit);
   EXPECT_THROW((void)session.make("chc:reads=earlier:cpu_test=on", Options{}), InputError);
   const CameraPath& path = session.bundle().paths.front();

@@ -234,8 +234,8 @@ CpuMesh make_cube() {
 class Frame {
  public:
   Frame(const Device& d, int width, int height) : d_(d), width_(width), height_(height) {
-    colour_ = make_image(VK_FORMAT_R8G8B8A8_UNORM, VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT, VK_IMAGE_ASPECT_COLOR_BIT, 0);
-    depth_ = make_image(VK_FORMAT_D32_SFLOAT, VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT, VK_IMAGE_ASPECT_DEPTH_BIT, 1);
+    make_image(VK_FORMAT_R8G8B8A8_UNORM, VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT, VK_IMAGE_ASPECT_COLOR_BIT, 0);
+    make_image(VK_FORMAT_D32_SFLOAT, VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT, VK_IMAGE_ASPECT_DEPTH_BIT, 1);
     for (int keep = 0; keep < 2; ++keep) {
       VkAttachmentDescription a[2]{};
       for (int i = 0; i < 2; ++i) {
@@ -274,11 +274,10 @@ class Frame {
       info.pDependencies = &dep;
       vk_check(vkCreateRenderPass(d.device, &info, nullptr, &passes_[keep]), "vkCreateRenderPass");
     }
-    const VkImageView views[2] = {views_[0], views_[1]};
     VkFramebufferCreateInfo fb{VK_STRUCTURE_TYPE_FRAMEBUFFER_CREATE_INFO};
     fb.renderPass = passes_[0];
     fb.attachmentCount = 2;
-    fb.pAttachments = views;
+    fb.pAttachments = views_;
     fb.width = std::uint32_t(width);
     fb.height = std::uint32_t(height);
     fb.layers = 1;
@@ -312,7 +311,8 @@ class Frame {
   }
 
  private:
-  int make_image(VkFormat format, VkImageUsageFlags usage, VkImageAspectFlags aspect, int slot) {
+  // Image `slot` (0 colour, 1 depth) with its memory and view.
+  void make_image(VkFormat format, VkImageUsageFlags usage, VkImageAspectFlags aspect, int slot) {
     VkImageCreateInfo info{VK_STRUCTURE_TYPE_IMAGE_CREATE_INFO};
     info.imageType = VK_IMAGE_TYPE_2D;
     info.format = format;
@@ -335,12 +335,10 @@ class Frame {
     view.format = format;
     view.subresourceRange = {aspect, 0, 1, 0, 1};
     vk_check(vkCreateImageView(d_.device, &view, nullptr, &views_[slot]), "vkCreateImageView");
-    return slot;
   }
 
   const Device& d_;
   int width_, height_;
-  int colour_ = 0, depth_ = 1;
   VkImage images_[2]{};
   VkDeviceMemory memories_[2]{};
   VkImageView views_[2]{};

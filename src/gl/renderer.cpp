@@ -1,6 +1,7 @@
 #include "occull/gl/renderer.hpp"
 
 #include "renderer_impl.hpp"
+#include "../render/scoped_timer.hpp"
 #include "gl.hpp"
 #include "scene_mesh.hpp"
 
@@ -21,24 +22,9 @@ using detail::kNoQuery;
 using detail::kBoxCapacity;
 using detail::MaterialData;
 
-using Clock = std::chrono::steady_clock;
-
-double ms_since(Clock::time_point t0) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
-}
-
-// Adds the wall time of the enclosing scope to a counter.
-class ScopedTimer {
- public:
-  explicit ScopedTimer(double& sink) : sink_(sink), t0_(Clock::now()) {}
-  ~ScopedTimer() { sink_ += ms_since(t0_); }
-  ScopedTimer(const ScopedTimer&) = delete;
-  ScopedTimer& operator=(const ScopedTimer&) = delete;
-
- private:
-  double& sink_;
-  Clock::time_point t0_;
-};
+using render::Clock;
+using render::ms_since;
+using render::ScopedTimer;
 
 
 // Under --draw multi, material runs shorter than this are drawn one object

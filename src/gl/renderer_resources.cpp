@@ -9,6 +9,7 @@
 #include "occull/input_limits.hpp"
 #include "scene_mesh.hpp"
 #include "occull/error.hpp"
+#include "../render/query_box_mesh.hpp"
 
 #include <glm/gtc/type_ptr.hpp>
 
@@ -206,29 +207,7 @@ GLenum query_target(QueryMode mode) {
   return GL_SAMPLES_PASSED;
 }
 
-// The query mesh: the 36 vertices of a unit cube's faces (outward,
-// counter-clockwise; corner i has bit 0 = x, bit 1 = y, bit 2 = z, as
-// Aabb::corner), then 6 per edge for its silhouette band (see kQueryVertex).
-struct QueryVertex {
-  glm::vec3 p, q, band;
-};
-std::vector<QueryVertex> query_mesh() {
-  const auto corner = [](int i) { return glm::vec3(float(i & 1), float((i >> 1) & 1), float((i >> 2) & 1)); };
-  static constexpr int faces[36] = {0, 2, 3, 0, 3, 1,  4, 5, 7, 4, 7, 6,  0, 4, 6, 0, 6, 2,
-                                    1, 3, 7, 1, 7, 5,  0, 1, 5, 0, 5, 4,  2, 6, 7, 2, 7, 3};
-  std::vector<QueryVertex> v;
-  for (int i : faces) v.push_back({corner(i), corner(i), {0, 0, 0}});
-  for (int axis = 0; axis < 3; ++axis)
-    for (int others = 0; others < 4; ++others) {
-      // The corner with bit `axis` clear and the other two bits from `others`, and its partner.
-      const int low = axis == 0 ? others << 1 : axis == 1 ? (others & 1) | ((others & 2) << 1) : others;
-      const glm::vec3 p = corner(low), q = corner(low | (1 << axis));
-      // (p,-) (q,-) (q,+)  (p,-) (q,+) (p,+)
-      for (const auto& [end, side] : {std::pair{0.f, -1.f}, {1.f, -1.f}, {1.f, 1.f}, {0.f, -1.f}, {1.f, 1.f}, {0.f, 1.f}})
-        v.push_back({p, q, {1.0f, end, side}});
-    }
-  return v;
-}
+using render::QueryVertex;
 
 }  // namespace
 
@@ -368,7 +347,7 @@ void Renderer::Impl::create_query_resources() {
   if (query_raster == QueryRaster::hardware)
     conservative_cap = has_extension("GL_NV_conservative_raster") ? GL_CONSERVATIVE_RASTERIZATION_NV
                                                                   : GL_CONSERVATIVE_RASTERIZATION_INTEL;
-  const std::vector<QueryVertex> mesh = query_mesh();
+  const std::vector<QueryVertex> mesh = render::query_box_mesh();
   query_vertices = query_raster == QueryRaster::margin && options.query_margin_px > 0.0f ? GLsizei(mesh.size()) : 36;
   query_slope_px = query_raster == QueryRaster::exact ? 0.0f : std::max(0.0f, options.query_margin_px);
   glCreateBuffers(1, &cube_vertices);

@@ -2,6 +2,7 @@
 // reads (each read of a query not yet submitted submits the commands so
 // far), conditional draws, the untimed truth pass and the read-backs.
 #include "renderer_impl.hpp"
+#include "../render/scoped_timer.hpp"
 
 #include <glm/gtc/type_ptr.hpp>
 
@@ -13,20 +14,9 @@
 namespace occull::vk {
 namespace {
 
-using Clock = std::chrono::steady_clock;
-double ms_since(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
-
-class ScopedTimer {
- public:
-  explicit ScopedTimer(double& sink) : sink_(sink), t0_(Clock::now()) {}
-  ~ScopedTimer() { sink_ += ms_since(t0_); }
-  ScopedTimer(const ScopedTimer&) = delete;
-  ScopedTimer& operator=(const ScopedTimer&) = delete;
-
- private:
-  double& sink_;
-  Clock::time_point t0_;
-};
+using render::Clock;
+using render::ms_since;
+using render::ScopedTimer;
 
 // The view's eye-relative projection (OpenGL clip conventions) in Vulkan's:
 // depth from [-1, 1] to [0, 1] when the view uses OpenGL's range, in double

@@ -3,6 +3,7 @@
 #include "renderer_impl.hpp"
 
 #include "occull/input_limits.hpp"
+#include "../render/query_box_mesh.hpp"
 
 #include <algorithm>
 #include <cstring>
@@ -28,27 +29,7 @@ constexpr VkFormat kColorFormat = VK_FORMAT_R8G8B8A8_UNORM;
 constexpr VkFormat kIdFormat = VK_FORMAT_R32_UINT;
 constexpr VkFormat kDepthFormat = VK_FORMAT_D32_SFLOAT;
 
-// The query mesh, as gl::Renderer's: a unit cube's 36 face vertices
-// (outward, counter-clockwise in OpenGL's terms), then 6 per edge for its
-// silhouette band (shaders/query.vert).
-struct QueryVertex {
-  glm::vec3 p, q, band;
-};
-std::vector<QueryVertex> query_mesh() {
-  const auto corner = [](int i) { return glm::vec3(float(i & 1), float((i >> 1) & 1), float((i >> 2) & 1)); };
-  static constexpr int faces[36] = {0, 2, 3, 0, 3, 1,  4, 5, 7, 4, 7, 6,  0, 4, 6, 0, 6, 2,
-                                    1, 3, 7, 1, 7, 5,  0, 1, 5, 0, 5, 4,  2, 6, 7, 2, 7, 3};
-  std::vector<QueryVertex> v;
-  for (int i : faces) v.push_back({corner(i), corner(i), {0, 0, 0}});
-  for (int axis = 0; axis < 3; ++axis)
-    for (int others = 0; others < 4; ++others) {
-      const int low = axis == 0 ? others << 1 : axis == 1 ? (others & 1) | ((others & 2) << 1) : others;
-      const glm::vec3 p = corner(low), q = corner(low | (1 << axis));
-      for (const auto& [end, side] : {std::pair{0.f, -1.f}, {1.f, -1.f}, {1.f, 1.f}, {0.f, -1.f}, {1.f, 1.f}, {0.f, 1.f}})
-        v.push_back({p, q, {1.0f, end, side}});
-    }
-  return v;
-}
+using render::QueryVertex;
 
 std::uint32_t memory_type(const VkPhysicalDeviceMemoryProperties& props, std::uint32_t bits, VkMemoryPropertyFlags want) {
   for (std::uint32_t i = 0; i < props.memoryTypeCount; ++i)
@@ -232,7 +213,7 @@ void Renderer::Impl::create_resources() {
     materials.push_back({c, std::max(0, m.shading_cost)});
   }
 
-  const std::vector<QueryVertex> mesh = query_mesh();
+  const std::vector<QueryVertex> mesh = render::query_box_mesh();
   query_vertices = options.query_margin_px > 0.0f ? std::uint32_t(mesh.size()) : 36;
   query_slope_px = std::max(0.0f, options.query_margin_px);
   cube = make_buffer(mesh.size() * sizeof(QueryVertex), VK_BUFFER_USAGE_VERTEX_BUFFER_BIT);
